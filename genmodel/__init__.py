@@ -1,0 +1,21 @@
+"""Generative-model specifications, compilation, growth, persistence and the map graph."""
+
+from .compile import compile
+from .model import Model, PoseModel
+from .spec import Factor, InductiveSpec, Modality, ModelSpec, PoseSpec, SparseB, SpecError, normalise
+from .transitions import SparseTransitions
+
+__all__ = [
+    "Factor",
+    "InductiveSpec",
+    "Modality",
+    "Model",
+    "ModelSpec",
+    "PoseModel",
+    "PoseSpec",
+    "SparseB",
+    "SparseTransitions",
+    "SpecError",
+    "compile",
+    "normalise",
+]

@@ -1,0 +1,270 @@
+"""The compiled generative model: arrays at a reserved capacity plus masks of live entries.
+
+Growth (:meth:`Model.add_state`, :meth:`Model.add_observation`) writes into reserved space;
+arrays are reallocated only when a capacity doubles, so compiled (jitted) functions keyed on
+shapes are reused and the number of reallocations after ``n`` growth steps is about
+``log2(n)`` (counted in :attr:`Model.compile_count`).
+
+The model holds data only; the maths lives in pure functions (``cogmap.inference``,
+``cogmap.planning``) that take these arrays.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .spec import Factor, InductiveSpec, Modality, SpecError
+from .transitions import SparseTransitions
+
+
+@dataclass
+class PoseModel:
+    """Stored metric pose per state (B_p) and the action-conditioned pose prediction."""
+
+    factor: int
+    poses: np.ndarray  # (capacity, 2)
+    headings: np.ndarray  # (num_moves,)
+    step: float
+    influence_radius: float
+    sigma: float
+
+    def predict(self, pose: np.ndarray, control: int, stay: int | None) -> np.ndarray:
+        """Pose after ``control`` from ``pose`` (the stay control keeps the pose)."""
+        if stay is not None and control == stay:
+            return np.asarray(pose, dtype=float).copy()
+        h = self.headings[control if stay is None or control < stay else control - 1]
+        return np.asarray(pose, dtype=float) + self.step * np.array([np.cos(h), np.sin(h)])
+
+
+@dataclass
+class Model:
+    """Arrays of a compiled model (pymdp layout, no batch axis) at capacity, with live sizes."""
+
+    factors: tuple[Factor, ...]
+    modalities: tuple[Modality, ...]
+    A: list[np.ndarray]
+    A_deps: tuple[tuple[int, ...], ...]
+    B: list  # np.ndarray (cap, cap, u) or SparseTransitions
+    C: list[np.ndarray]
+    D: list[np.ndarray]
+    pA: list[np.ndarray | None]
+    pB: list[np.ndarray | None]
+    C_states: list[np.ndarray]
+    num_states: list[int]
+    num_obs: list[int]
+    pose: PoseModel | None = None
+    inductive: InductiveSpec | None = None
+    collision_preference: float | None = None
+    prior_count: float = 1.0
+    compile_count: int = 0
+    _listeners: list = field(default_factory=list, repr=False)
+
+    # -- names and shapes ------------------------------------------------------------------
+    @property
+    def factor_names(self) -> tuple[str, ...]:
+        return tuple(f.name for f in self.factors)
+
+    @property
+    def modality_names(self) -> tuple[str, ...]:
+        return tuple(m.name for m in self.modalities)
+
+    @property
+    def num_controls(self) -> list[int]:
+        return [f.num_controls for f in self.factors]
+
+    def factor_index(self, name: str | int) -> int:
+        if isinstance(name, int | np.integer):
+            if not 0 <= int(name) < len(self.factors):
+                raise SpecError(f"factor index {name} out of range (have {len(self.factors)})")
+            return int(name)
+        try:
+            return self.factor_names.index(name)
+        except ValueError:
+            raise SpecError(f"unknown factor '{name}' (known: {list(self.factor_names)})") from None
+
+    def modality_index(self, name: str | int) -> int:
+        if isinstance(name, int | np.integer):
+            if not 0 <= int(name) < len(self.modalities):
+                raise SpecError(f"modality index {name} out of range")
+            return int(name)
+        try:
+            return self.modality_names.index(name)
+        except ValueError:
+            known = list(self.modality_names)
+            raise SpecError(f"unknown modality '{name}' (known: {known})") from None
+
+    def state_capacity(self, f: int) -> int:
+        return self.D[f].shape[0]
+
+    def obs_capacity(self, m: int) -> int:
+        return self.A[m].shape[0]
+
+    def state_mask(self, f: int) -> np.ndarray:
+        mask = np.zeros(self.state_capacity(f), dtype=bool)
+        mask[: self.num_states[f]] = True
+        return mask
+
+    def obs_mask(self, m: int) -> np.ndarray:
+        mask = np.zeros(self.obs_capacity(m), dtype=bool)
+        mask[: self.num_obs[m]] = True
+        return mask
+
+    def is_sparse(self, f: int) -> bool:
+        return isinstance(self.B[f], SparseTransitions)
+
+    # -- live views (copies trimmed to live sizes: references, export, tests) ---------------
+    def live_A(self, m: int) -> np.ndarray:
+        idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
+        return self.A[m][idx]
+
+    def live_pA(self, m: int) -> np.ndarray | None:
+        if self.pA[m] is None:
+            return None
+        idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
+        return self.pA[m][idx]
+
+    def live_B(self, f: int) -> np.ndarray:
+        n = self.num_states[f]
+        if self.is_sparse(f):
+            return self.B[f].to_dense(n)
+        return self.B[f][:n, :n]
+
+    def live_pB(self, f: int) -> np.ndarray | None:
+        n = self.num_states[f]
+        if self.is_sparse(f):
+            return None if self.B[f].counts is None else self.B[f].counts_dense(n)
+        return None if self.pB[f] is None else self.pB[f][:n, :n]
+
+    def live_C(self, m: int) -> np.ndarray:
+        return self.C[m][: self.num_obs[m]]
+
+    def live_D(self, f: int) -> np.ndarray:
+        return self.D[f][: self.num_states[f]]
+
+    def predict(self, f: int, q: np.ndarray, u: int) -> np.ndarray:
+        """One-step prediction of factor ``f`` under control ``u`` (dense or sparse)."""
+        B = self.B[f]
+        if isinstance(B, SparseTransitions):
+            return B.predict(q, u)
+        n = q.shape[0]
+        return B[:n, :n, u] @ q
+
+    # -- growth ----------------------------------------------------------------------------
+    def add_state(self, factor: str | int = 0, pose=None) -> int:
+        """Add one state to a growable factor; returns its index.
+
+        The new state's likelihood columns are uniform over live outcomes (with ``prior_count``
+        Dirichlet counts), its transitions self-loop with ``prior_count`` counts, the stay
+        control stays the identity, no existing count changes, and every column stays
+        normalised. ``pose`` (x, y) is stored when the model has a pose factor.
+        """
+        f = self.factor_index(factor)
+        if not self.factors[f].growable:
+            raise SpecError(f"factor '{self.factors[f].name}' is not growable")
+        s = self.num_states[f]
+        if s == self.state_capacity(f):
+            self._grow_state_capacity(f, 2 * max(1, s))
+        self.num_states[f] = s + 1
+        for m, deps in enumerate(self.A_deps):
+            if f not in deps:
+                continue
+            axis = 1 + deps.index(f)
+            n_o = self.num_obs[m]
+            col = [slice(None)] * self.A[m].ndim
+            col[axis] = s
+            col = tuple(col)
+            self.A[m][col] = 0.0
+            self.A[m][col][:n_o] = 1.0 / max(1, n_o)
+            if self.pA[m] is not None:
+                self.pA[m][col] = 0.0
+                self.pA[m][col][:n_o] = self.prior_count
+        B = self.B[f]
+        if isinstance(B, SparseTransitions):
+            B.succ[s] = s
+            B.prob[s] = 0.0
+            B.prob[s, :, 0] = 1.0
+            if B.counts is not None:
+                B.counts[s] = 0.0
+                B.counts[s, :, 0] = self.prior_count
+        else:
+            B[:, s, :] = 0.0
+            B[s, s, :] = 1.0
+            if self.pB[f] is not None:
+                self.pB[f][:, s, :] = 0.0
+                self.pB[f][s, s, :] = self.prior_count
+        self.C_states[f][s] = 0.0
+        if self.pose is not None and self.pose.factor == f:
+            if pose is None:
+                raise SpecError(f"factor '{self.factors[f].name}' has poses: add_state needs pose=")
+            self.pose.poses[s] = pose
+        return s
+
+    def add_observation(self, modality: str | int = 0) -> int:
+        """Add one outcome to a growable modality; returns its index.
+
+        With Dirichlet counts, every live column gains ``prior_count`` for the new outcome and
+        is renormalised from its counts (existing counts unchanged); without counts the new
+        outcome starts with probability 0 everywhere.
+        """
+        m = self.modality_index(modality)
+        if not self.modalities[m].growable:
+            raise SpecError(f"modality '{self.modalities[m].name}' is not growable")
+        o = self.num_obs[m]
+        if o == self.obs_capacity(m):
+            self._grow_obs_capacity(m, 2 * max(1, o))
+        self.num_obs[m] = o + 1
+        live = tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
+        self.A[m][(o,) + live] = 0.0
+        if self.pA[m] is not None:
+            self.pA[m][(o,) + live] = self.prior_count
+            counts = self.pA[m][(slice(0, o + 1),) + live]
+            self.A[m][(slice(0, o + 1),) + live] = counts / counts.sum(axis=0, keepdims=True)
+        self.C[m][o] = 0.0
+        return o
+
+    def _grow_state_capacity(self, f: int, cap: int) -> None:
+        old = self.state_capacity(f)
+        self.compile_count += 1
+        for m, deps in enumerate(self.A_deps):
+            if f not in deps:
+                continue
+            axis = 1 + deps.index(f)
+            self.A[m] = _pad_axis(self.A[m], axis, cap)
+            if self.pA[m] is not None:
+                self.pA[m] = _pad_axis(self.pA[m], axis, cap)
+        B = self.B[f]
+        if isinstance(B, SparseTransitions):
+            B.grow(cap)
+        else:
+            newB = np.zeros((cap, cap, B.shape[2]))
+            newB[:old, :old] = B
+            newB[np.arange(old, cap), np.arange(old, cap), :] = 1.0
+            self.B[f] = newB
+            if self.pB[f] is not None:
+                newp = np.zeros((cap, cap, B.shape[2]))
+                newp[:old, :old] = self.pB[f]
+                self.pB[f] = newp
+        self.D[f] = _pad_axis(self.D[f], 0, cap)
+        self.C_states[f] = _pad_axis(self.C_states[f], 0, cap)
+        if self.pose is not None and self.pose.factor == f:
+            self.pose.poses = _pad_axis(self.pose.poses, 0, cap)
+
+    def _grow_obs_capacity(self, m: int, cap: int) -> None:
+        self.compile_count += 1
+        self.A[m] = _pad_axis(self.A[m], 0, cap)
+        if self.pA[m] is not None:
+            self.pA[m] = _pad_axis(self.pA[m], 0, cap)
+        self.C[m] = _pad_axis(self.C[m], 0, cap)
+
+
+def _pad_axis(x: np.ndarray, axis: int, size: int) -> np.ndarray:
+    """Zero-pad ``x`` along ``axis`` up to ``size``."""
+    shape = list(x.shape)
+    shape[axis] = size
+    out = np.zeros(shape, dtype=x.dtype)
+    idx = [slice(None)] * x.ndim
+    idx[axis] = slice(0, x.shape[axis])
+    out[tuple(idx)] = x
+    return out
