@@ -1,0 +1,306 @@
+"""Shared pieces of every inference scheme: the result type, input checking and evidence.
+
+Every scheme has the call
+
+    posterior, info = scheme(model, prior, observations, actions=None, **options)
+
+* ``prior``: one belief per factor over the states at the first time step, *before* that
+  step's observation (``model.D`` or a predicted empirical prior). Each entry has the factor's
+  live length (or its capacity, with zero mass on not-yet-live states) and sums to 1.
+* ``observations``: a sequence over time (length ``T >= 1``). Each step is either
+
+  - a list/tuple with one entry per modality, optionally followed by one more entry holding
+    the metric pose ``(x, y)`` when the model has a pose factor, or
+  - a dict keyed by modality name (or index), plus the key ``"pose"`` for the metric pose.
+    Modalities absent from the dict did not report.
+
+  Each modality entry is an outcome index, a probability vector over the live outcomes
+  (treated as soft evidence: likelihood ``sum_o p(o) A[o, s]``) or ``None`` (missing: no
+  evidence). The metric pose contributes the likelihood ``exp(-|p - poses[s]|^2 / (2 sigma^2))``
+  over the live states of the pose factor (the Gaussian's constant ``2 pi sigma^2`` is left
+  out, so free energies with pose evidence are defined up to that constant).
+* ``actions``: ``T - 1`` control tuples (one control per factor; a bare int is accepted for a
+  single factor). May be omitted when every factor has a single control.
+
+``posterior`` is the per-factor list of beliefs (live length) at the last step and ``info`` an
+:class:`InferenceInfo`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+POSE_KEY = "pose"
+ATOL = 1e-6
+#: floor used inside logarithms by the variational schemes (the same floor as pymdp 1.0)
+LOG_FLOOR = float(np.finfo(float).eps)
+
+
+class InferenceError(ValueError):
+    """Bad input to an inference scheme; the message names the argument and the problem."""
+
+
+class InferenceInfo(NamedTuple):
+    """What a scheme reports beside the posterior.
+
+    ``free_energy``: variational free energy of the last step in nats (for exact Bayes,
+    ``-log p(o_T | o_<T)``). ``history``: per-time tuples of per-factor beliefs (filtered or
+    smoothed, as the scheme documents). ``iterations``: update sweeps used at the last step.
+    ``total_free_energy``: free energy of the whole sequence (``-log p(o_1:T)`` for exact Bayes).
+    """
+
+    free_energy: float
+    history: tuple
+    iterations: int
+    total_free_energy: float | None = None
+
+
+@dataclass(frozen=True)
+class Evidence:
+    """Likelihood of one observation over the live states of the factors ``deps``.
+
+    The true likelihood is ``lik * exp(log_scale)``; ``lik`` is rescaled to max 1 where that
+    avoids underflow (pose evidence far from every stored pose).
+    """
+
+    deps: tuple[int, ...]
+    lik: np.ndarray
+    log_scale: float = 0.0
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class Problem:
+    """Checked inputs on live slices: ``prior[f]``, ``evidence[t]``, ``actions[t]``."""
+
+    sizes: tuple[int, ...]
+    prior: tuple[np.ndarray, ...]
+    evidence: tuple[tuple[Evidence, ...], ...]
+    actions: tuple[tuple[int, ...], ...]
+
+    @property
+    def T(self) -> int:  # noqa: N802 - conventional name
+        return len(self.evidence)
+
+    @property
+    def num_factors(self) -> int:
+        return len(self.sizes)
+
+
+# -- checking --------------------------------------------------------------------------------
+def _check_distribution(x, n_live: int, cap: int, what: str) -> np.ndarray:
+    try:
+        arr = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise InferenceError(f"{what}: not a numeric vector") from None
+    if arr.ndim != 1 or arr.shape[0] not in (n_live, cap):
+        raise InferenceError(
+            f"{what}: expected a vector of length {n_live} (live) or {cap} (capacity), "
+            f"got shape {arr.shape}"
+        )
+    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
+        raise InferenceError(f"{what}: entries must be finite and non-negative")
+    if arr.shape[0] > n_live and np.any(arr[n_live:] > 0):
+        raise InferenceError(f"{what}: puts mass on entries beyond the {n_live} live ones")
+    arr = arr[:n_live]
+    total = arr.sum()
+    if abs(total - 1.0) > ATOL:
+        raise InferenceError(f"{what}: sums to {total:.6g}, expected 1 (normalise it)")
+    return arr
+
+
+def check_prior(model, prior) -> tuple[np.ndarray, ...]:
+    F = len(model.factors)
+    if isinstance(prior, np.ndarray) and prior.ndim == 1 and F == 1:
+        prior = [prior]
+    if not isinstance(prior, Sequence) or isinstance(prior, str | bytes):
+        raise InferenceError(f"prior: expected a list with one belief per factor ({F})")
+    if len(prior) != F:
+        raise InferenceError(f"prior: has {len(prior)} entries, the model has {F} factor(s)")
+    return tuple(
+        _check_distribution(
+            p, model.num_states[f], model.state_capacity(f), f"prior for factor '{model.factors[f].name}'"
+        )
+        for f, p in enumerate(prior)
+    )
+
+
+def _split_step(model, step, t: int) -> tuple[list, object]:
+    """Per-modality entries (None when missing) and the metric pose (or None)."""
+    M = len(model.modalities)
+    has_pose = model.pose is not None
+    if isinstance(step, Mapping):
+        entries: list = [None] * M
+        pose = None
+        for key, value in step.items():
+            if key == POSE_KEY and POSE_KEY not in model.modality_names:
+                if not has_pose:
+                    raise InferenceError(f"observations[{t}]: a pose was given but the model has no pose factor")
+                pose = value
+                continue
+            try:
+                m = model.modality_index(key)
+            except ValueError as err:
+                raise InferenceError(f"observations[{t}]: {err}") from None
+            entries[m] = value
+        return entries, pose
+    if isinstance(step, np.ndarray) and step.ndim == 1 and np.issubdtype(step.dtype, np.integer):
+        step = list(step)
+    if not isinstance(step, Sequence) or isinstance(step, str | bytes):
+        if M == 1 and (step is None or isinstance(step, int | np.integer)):
+            return [step], None
+        raise InferenceError(
+            f"observations[{t}]: expected a list with one entry per modality ({M}) or a dict"
+        )
+    n = len(step)
+    if n == M:
+        return list(step), None
+    if has_pose and n == M + 1:
+        return list(step[:M]), step[M]
+    extra = " (+1 for the metric pose)" if has_pose else ""
+    raise InferenceError(f"observations[{t}]: has {n} entries, the model has {M} modalities{extra}")
+
+
+def modality_evidence(model, m: int, value, t: int = 0) -> Evidence | None:
+    """Likelihood of one modality entry over its factors' live states (None if missing)."""
+    if value is None:
+        return None
+    name = model.modalities[m].name
+    n_o = model.num_obs[m]
+    deps = model.A_deps[m]
+    live = tuple(slice(0, model.num_states[f]) for f in deps)
+    if isinstance(value, bool | np.bool_):
+        raise InferenceError(f"observations[{t}] for modality '{name}': got a bool, expected an index")
+    if isinstance(value, int | np.integer):
+        o = int(value)
+        if not 0 <= o < n_o:
+            raise InferenceError(
+                f"observations[{t}] for modality '{name}': index {o} out of range "
+                f"(live outcomes 0..{n_o - 1})"
+            )
+        return Evidence(deps, model.A[m][(o,) + live], 0.0, name)
+    p = _check_distribution(value, n_o, model.obs_capacity(m), f"observations[{t}] for modality '{name}'")
+    lik = np.tensordot(p, model.A[m][(slice(0, n_o),) + live], axes=(0, 0))
+    return Evidence(deps, lik, 0.0, name)
+
+
+def pose_evidence(model, pose, t: int = 0) -> Evidence | None:
+    """Gaussian-kernel likelihood of a metric pose over the live states of the pose factor."""
+    if pose is None:
+        return None
+    pm = model.pose
+    try:
+        p = np.asarray(pose, dtype=float)
+    except (TypeError, ValueError):
+        raise InferenceError(f"observations[{t}] pose: not numeric") from None
+    if p.shape != (2,) or not np.all(np.isfinite(p)):
+        raise InferenceError(f"observations[{t}] pose: expected finite (x, y), got {pose!r}")
+    n = model.num_states[pm.factor]
+    diff = pm.poses[:n] - p
+    d2 = diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1]
+    logk = d2 * (-0.5 / (pm.sigma * pm.sigma))
+    top = float(logk.max())
+    return Evidence((pm.factor,), np.exp(logk - top), top, POSE_KEY)
+
+
+def _check_actions(model, actions, T: int) -> tuple[tuple[int, ...], ...]:
+    F = len(model.factors)
+    U = model.num_controls
+    if actions is None:
+        if T > 1 and any(u > 1 for u in U):
+            raise InferenceError(f"actions: {T - 1} control tuples are needed for {T} observations")
+        return tuple((0,) * F for _ in range(T - 1))
+    if isinstance(actions, str | bytes) or not hasattr(actions, "__len__"):
+        raise InferenceError("actions: expected a sequence of per-factor control tuples")
+    if len(actions) != T - 1:
+        raise InferenceError(f"actions: has {len(actions)} entries, expected T - 1 = {T - 1}")
+    out = []
+    for t, a in enumerate(actions):
+        if isinstance(a, int | np.integer):
+            a = (a,)
+        a = tuple(int(x) for x in np.ravel(np.asarray(a)))
+        if len(a) != F:
+            raise InferenceError(f"actions[{t}]: has {len(a)} controls, the model has {F} factor(s)")
+        for f, u in enumerate(a):
+            if not 0 <= u < U[f]:
+                raise InferenceError(
+                    f"actions[{t}]: control {u} out of range for factor "
+                    f"'{model.factors[f].name}' ({U[f]} controls)"
+                )
+        out.append(a)
+    return tuple(out)
+
+
+def prepare(model, prior, observations, actions=None) -> Problem:
+    """Check a scheme's inputs and turn observations into :class:`Evidence` on live slices.
+
+    User-written schemes can call this to get the same checks and conventions as ours.
+    """
+    priors = check_prior(model, prior)
+    if isinstance(observations, str | bytes) or not hasattr(observations, "__len__"):
+        raise InferenceError("observations: expected a sequence over time (length T >= 1)")
+    T = len(observations)
+    if T < 1:
+        raise InferenceError("observations: empty sequence (need T >= 1)")
+    evidence = []
+    for t, step in enumerate(observations):
+        entries, pose = _split_step(model, step, t)
+        ev = [modality_evidence(model, m, v, t) for m, v in enumerate(entries)]
+        ev.append(pose_evidence(model, pose, t))
+        evidence.append(tuple(e for e in ev if e is not None))
+    return Problem(
+        tuple(model.num_states), priors, tuple(evidence), _check_actions(model, actions, T)
+    )
+
+
+# -- small maths -----------------------------------------------------------------------------
+def floor_log(x: np.ndarray) -> np.ndarray:
+    return np.log(np.maximum(x, LOG_FLOOR))
+
+
+def softmax(x: np.ndarray) -> np.ndarray:
+    e = np.exp(x - x.max())
+    return e / e.sum()
+
+
+def xlogx_sum(q: np.ndarray) -> float:
+    nz = q > 0
+    return float(np.sum(q[nz] * np.log(q[nz])))
+
+
+def dense_transition(model, f: int, u: int) -> np.ndarray:
+    """Live dense ``B[f][:, :, u]`` (``(next, current)``) for dense or sparse storage."""
+    n = model.num_states[f]
+    B = model.B[f]
+    if model.is_sparse(f):
+        out = np.zeros((n, n))
+        np.add.at(out, (B.succ[:n, u].ravel(), np.repeat(np.arange(n), B.slots)), B.prob[:n, u].ravel())
+        return out
+    return B[:n, :n, u]
+
+
+def marginal_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs, f: int) -> np.ndarray:
+    """``E_{q(other deps)}[loglik]`` as a function of factor ``f`` (which must be in ``deps``)."""
+    x = loglik
+    keep = deps.index(f)
+    # contract the trailing axes first so the axis numbers of the leading ones stay valid
+    for axis in range(len(deps) - 1, -1, -1):
+        if axis != keep:
+            x = np.tensordot(x, qs[deps[axis]], axes=([axis], [0]))
+    return x
+
+
+def expected_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs) -> float:
+    x = loglik
+    for axis in range(len(deps) - 1, -1, -1):
+        x = np.tensordot(x, qs[deps[axis]], axes=([axis], [0]))
+    return float(x)
+
+
+def predict_factorised(model, qs, action) -> list[np.ndarray]:
+    """Per-factor one-step prediction ``B[f][:, :, u_f] q_f`` (dense or sparse)."""
+    return [model.predict(f, q, int(u)) for f, (q, u) in enumerate(zip(qs, action, strict=True))]

@@ -1,0 +1,96 @@
+"""Exact Bayesian state inference by enumerating the joint (product) state space.
+
+Forward filtering gives the last-step marginals and ``-log p(o_T | o_<T)``; a backward pass
+gives smoothed marginals for every step (``info.history``). Cost grows with the product of the
+live factor sizes, so the joint size is capped (option ``max_joint``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import InferenceError, InferenceInfo, dense_transition, prepare
+
+MAX_JOINT = 1 << 16
+
+
+def _apply(B: np.ndarray, x: np.ndarray, axis: int, transpose: bool = False) -> np.ndarray:
+    """Apply a ``(next, current)`` matrix along ``axis`` of the joint tensor ``x``."""
+    y = np.tensordot(B, x, axes=([0 if transpose else 1], [axis]))
+    return np.moveaxis(y, 0, axis)
+
+
+def _joint_likelihood(evidence, sizes) -> tuple[np.ndarray, float]:
+    lik = np.ones(sizes)
+    log_scale = 0.0
+    F = len(sizes)
+    for ev in evidence:
+        shape = [1] * F
+        for f, n in zip(ev.deps, ev.lik.shape, strict=True):
+            shape[f] = n
+        # a factor may appear once per modality; reorder the axes into factor order
+        order = np.argsort(ev.deps)
+        lik = lik * np.transpose(ev.lik, order).reshape(shape)
+        log_scale += ev.log_scale
+    return lik, log_scale
+
+
+def _marginals(joint: np.ndarray) -> tuple[np.ndarray, ...]:
+    F = joint.ndim
+    return tuple(joint.sum(axis=tuple(g for g in range(F) if g != f)) for f in range(F))
+
+
+def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_joint: int = MAX_JOINT):
+    """Exact Bayes over the joint state space (the prior is taken as a product of factors).
+
+    ``info.history`` holds smoothed marginals (``smooth=True``) or filtered ones.
+    Raises :class:`InferenceError` when the joint has more than ``max_joint`` states or the
+    observations have zero probability under the model.
+    """
+    prob = prepare(model, prior, observations, actions)
+    sizes = prob.sizes
+    joint_size = int(np.prod(sizes))
+    if joint_size > max_joint:
+        raise InferenceError(
+            f"exact: the joint state space has {joint_size} states (sizes {list(sizes)}), above "
+            f"max_joint={max_joint}; use a variational scheme or raise max_joint"
+        )
+    F = len(sizes)
+    alpha = prob.prior[0]
+    for f in range(1, F):
+        alpha = np.multiply.outer(alpha, prob.prior[f])
+    alpha = alpha.reshape(sizes)
+    alphas, liks, mats = [], [], []
+    log_c = []
+    for t in range(prob.T):
+        if t > 0:
+            step = [dense_transition(model, f, u) for f, u in enumerate(prob.actions[t - 1])]
+            mats.append(step)
+            for f in range(F):
+                alpha = _apply(step[f], alpha, f)
+        lik, scale = _joint_likelihood(prob.evidence[t], sizes)
+        post = alpha * lik
+        c = post.sum()
+        if not c > 0:
+            raise InferenceError(f"exact: observations up to step {t} have zero probability under the model")
+        alpha = post / c
+        log_c.append(np.log(c) + scale)
+        alphas.append(alpha)
+        liks.append(lik / c)
+    if smooth:
+        beta = np.ones(sizes)
+        gammas = [alphas[-1]]
+        for t in range(prob.T - 2, -1, -1):
+            x = liks[t + 1] * beta
+            for f in range(F):
+                x = _apply(mats[t][f], x, f, transpose=True)
+            beta = x
+            g = alphas[t] * beta
+            gammas.append(g / g.sum())
+        gammas.reverse()
+    else:
+        gammas = alphas
+    history = tuple(_marginals(g) for g in gammas)
+    posterior = list(_marginals(alphas[-1]))
+    info = InferenceInfo(float(-log_c[-1]), history, 1, float(-np.sum(log_c)))
+    return posterior, info

@@ -1,0 +1,45 @@
+"""Registry of inference schemes by name.
+
+A scheme is any callable ``scheme(model, prior, observations, actions=None, **options)``
+returning ``(posterior, info)`` (see :mod:`cogmap.inference.base`). Users add their own with
+:func:`register` without touching this package.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+_SCHEMES: dict[str, Callable] = {}
+
+
+def register(name: str, fn: Callable | None = None, *, overwrite: bool = False):
+    """Register ``fn`` under ``name``; usable as a decorator (``@register("mine")``)."""
+    if not isinstance(name, str) or not name:
+        raise ValueError("register: name must be a non-empty string")
+
+    def _add(f: Callable) -> Callable:
+        if not callable(f):
+            raise TypeError(f"register('{name}'): expected a callable, got {type(f).__name__}")
+        if name in _SCHEMES and not overwrite and _SCHEMES[name] is not f:
+            raise ValueError(f"register: a scheme named '{name}' exists (pass overwrite=True)")
+        _SCHEMES[name] = f
+        return f
+
+    return _add if fn is None else _add(fn)
+
+
+def unregister(name: str) -> None:
+    if name not in _SCHEMES:
+        raise KeyError(f"no inference scheme named '{name}'")
+    del _SCHEMES[name]
+
+
+def get(name: str) -> Callable:
+    try:
+        return _SCHEMES[name]
+    except KeyError:
+        raise KeyError(f"unknown inference scheme '{name}' (available: {available()})") from None
+
+
+def available() -> tuple[str, ...]:
+    return tuple(sorted(_SCHEMES))

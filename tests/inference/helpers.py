@@ -1,0 +1,71 @@
+"""Random small models for inference tests."""
+
+from __future__ import annotations
+
+import numpy as np
+from cogmap.genmodel import Factor, Modality, ModelSpec, compile
+
+
+def dirichlet(rng, shape, conc=1.0):
+    x = rng.gamma(conc, size=shape)
+    return x / x.sum(axis=0, keepdims=True)
+
+
+def random_model(seed, sizes=(3,), controls=None, modalities=((0,),), obs_sizes=None, conc=1.0,
+                 growable=False):
+    """Random model: ``modalities`` lists each modality's factor dependencies."""
+    rng = np.random.default_rng(seed)
+    controls = controls or tuple(2 for _ in sizes)
+    obs_sizes = obs_sizes or tuple(3 + i for i in range(len(modalities)))
+    factors = [
+        Factor(f"f{i}", n, num_controls=u, growable=growable)
+        for i, (n, u) in enumerate(zip(sizes, controls, strict=True))
+    ]
+    mods = [
+        Modality(f"m{j}", no, tuple(f"f{i}" for i in deps))
+        for j, (deps, no) in enumerate(zip(modalities, obs_sizes, strict=False))
+    ]
+    A = {
+        f"m{j}": dirichlet(rng, (no,) + tuple(sizes[i] for i in deps), conc)
+        for j, (deps, no) in enumerate(zip(modalities, obs_sizes, strict=False))
+    }
+    B = {f"f{i}": dirichlet(rng, (n, n, u), conc) for i, (n, u) in enumerate(zip(sizes, controls, strict=False))}
+    D = {f"f{i}": dirichlet(rng, (n,), 2.0) for i, n in enumerate(sizes)}
+    return compile(ModelSpec(factors=factors, modalities=mods, A=A, B=B, D=D))
+
+
+def random_sequence(model, T, seed, missing=0.0):
+    """Random observations (indices, sometimes missing) and actions for ``model``."""
+    rng = np.random.default_rng(seed + 1000)
+    obs = []
+    for _ in range(T):
+        step = [int(rng.integers(n)) for n in model.num_obs]
+        step = [None if rng.random() < missing else o for o in step]
+        obs.append(step)
+    actions = [tuple(int(rng.integers(u)) for u in model.num_controls) for _ in range(T - 1)]
+    return obs, actions
+
+
+def brute_force_log_evidence(model, prior, obs, actions):
+    """log p(o_1:T) by summing over every state path (tiny models only)."""
+    import itertools
+
+    F = len(model.factors)
+    sizes = model.num_states
+    joint_states = list(itertools.product(*[range(n) for n in sizes]))
+    T = len(obs)
+    total = 0.0
+    for path in itertools.product(joint_states, repeat=T):
+        p = np.prod([prior[f][path[0][f]] for f in range(F)])
+        for t in range(T):
+            if t > 0:
+                p *= np.prod(
+                    [model.B[f][path[t][f], path[t - 1][f], actions[t - 1][f]] for f in range(F)]
+                )
+            for m, o in enumerate(obs[t]):
+                if o is None:
+                    continue
+                idx = (o,) + tuple(path[t][f] for f in model.A_deps[m])
+                p *= model.A[m][idx]
+        total += p
+    return float(np.log(total))
