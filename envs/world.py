@@ -1,0 +1,114 @@
+"""pybullet scene built from a layout (DIRECT mode, one client per scene)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as p
+
+from .geometry import Box, Cylinder
+from .layouts import Layout
+
+FLOOR_RGBA = (0.55, 0.55, 0.5, 1.0)
+
+
+def _quat(yaw: float):
+    return (0.0, 0.0, float(np.sin(yaw / 2)), float(np.cos(yaw / 2)))
+
+
+class PyBulletScene:
+    """Static shapes as zero-mass bodies, a cylinder robot, rays and a pinhole camera."""
+
+    def __init__(self, layout: Layout, robot_radius: float = 0.22, robot_height: float = 0.2):
+        self.client = p.connect(p.DIRECT)
+        self.bodies: dict[str, int] = {}
+        self.heights: dict[str, float] = {}
+        cid = self.client
+        xmin, ymin, xmax, ymax = layout.bounds
+        half = [(xmax - xmin) / 2 + 1.0, (ymax - ymin) / 2 + 1.0, 0.01]
+        vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=FLOOR_RGBA,
+                                  physicsClientId=cid)
+        self.floor = p.createMultiBody(0, -1, vis, [(xmin + xmax) / 2, (ymin + ymax) / 2, -0.01],
+                                       physicsClientId=cid)
+        for s in layout.shapes:
+            self.bodies[s.name] = self._add(s)
+            self.heights[s.name] = s.height
+        col = p.createCollisionShape(p.GEOM_CYLINDER, radius=robot_radius, height=robot_height,
+                                     physicsClientId=cid)
+        # a tiny invisible visual keeps the robot out of its own camera images
+        vis = p.createVisualShape(p.GEOM_SPHERE, radius=1e-3, rgbaColor=(0, 0, 0, 0),
+                                  physicsClientId=cid)
+        self.robot_height = robot_height
+        self.robot = p.createMultiBody(0, col, vis, [0, 0, robot_height / 2],
+                                       physicsClientId=cid)
+        self.names = {v: k for k, v in self.bodies.items()}
+        self._proj = {}
+
+    def _add(self, s) -> int:
+        cid = self.client
+        rgba = (*s.color, 1.0)
+        if isinstance(s, Box):
+            he = [s.sx / 2, s.sy / 2, s.height / 2]
+            col = p.createCollisionShape(p.GEOM_BOX, halfExtents=he, physicsClientId=cid)
+            vis = p.createVisualShape(p.GEOM_BOX, halfExtents=he, rgbaColor=rgba,
+                                      physicsClientId=cid)
+            yaw = s.yaw
+        elif isinstance(s, Cylinder):
+            col = p.createCollisionShape(p.GEOM_CYLINDER, radius=s.radius, height=s.height,
+                                         physicsClientId=cid)
+            vis = p.createVisualShape(p.GEOM_CYLINDER, radius=s.radius, length=s.height,
+                                      rgbaColor=rgba, physicsClientId=cid)
+            yaw = 0.0
+        else:  # pragma: no cover - layouts only hold boxes and cylinders
+            raise TypeError(f"unsupported shape {s!r}")
+        return p.createMultiBody(0, col, vis, [s.x, s.y, s.height / 2], _quat(yaw),
+                                 physicsClientId=cid)
+
+    def set_robot(self, pose) -> None:
+        p.resetBasePositionAndOrientation(self.robot, [pose[0], pose[1], self.robot_height / 2],
+                                          _quat(pose[2]), physicsClientId=self.client)
+
+    def move_body(self, name: str, x: float, y: float, yaw: float = 0.0) -> None:
+        p.resetBasePositionAndOrientation(self.bodies[name], [x, y, self.heights[name] / 2],
+                                          _quat(yaw), physicsClientId=self.client)
+
+    def cast(self, origin_xy, headings, z: float, r_min: float, r_max: float):
+        """Horizontal rays from `r_min` to `r_max` around origin at height z.
+
+        Starting outside the robot disc excludes the robot body. Returns ranges measured from
+        the origin (r_max where nothing is hit) and the hit body ids (-1 for no hit).
+        """
+        c, s = np.cos(headings), np.sin(headings)
+        ox, oy = float(origin_xy[0]), float(origin_xy[1])
+        frm = np.stack([ox + r_min * c, oy + r_min * s, np.full_like(c, z)], 1)
+        to = np.stack([ox + r_max * c, oy + r_max * s, np.full_like(c, z)], 1)
+        out = p.rayTestBatch(frm.tolist(), to.tolist(), physicsClientId=self.client)
+        ids = np.array([o[0] for o in out])
+        frac = np.array([o[2] for o in out])
+        hit = (ids >= 0) & (ids != self.robot)
+        ranges = np.where(hit, r_min + frac * (r_max - r_min), r_max)
+        return ranges, np.where(hit, ids, -1)
+
+    def view(self, eye_xy, z: float, heading: float, width: int, height: int,
+             fov_deg: float) -> np.ndarray:
+        """One RGB image (height, width, 3) looking horizontally along `heading`."""
+        key = (width, height, fov_deg)
+        if key not in self._proj:
+            self._proj[key] = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 30.0)
+        eye = [float(eye_xy[0]), float(eye_xy[1]), z]
+        tgt = [eye[0] + np.cos(heading), eye[1] + np.sin(heading), z]
+        vm = p.computeViewMatrix(eye, tgt, [0, 0, 1])
+        _, _, rgba, _, _ = p.getCameraImage(width, height, vm, self._proj[key],
+                                            renderer=p.ER_TINY_RENDERER, shadow=0,
+                                            physicsClientId=self.client)
+        return np.asarray(rgba, np.uint8).reshape(height, width, 4)[..., :3]
+
+    def closest_distance(self, name: str, max_dist: float = 1.0) -> float:
+        """pybullet's closest distance between the robot and one body (for cross-checks)."""
+        pts = p.getClosestPoints(self.robot, self.bodies[name], max_dist,
+                                 physicsClientId=self.client)
+        return min((q[8] for q in pts), default=np.inf)
+
+    def close(self) -> None:
+        if self.client is not None and p.isConnected(self.client):
+            p.disconnect(self.client)
+        self.client = None
