@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from enum import Enum
 
 import numpy as np
+
 from cogmap.genmodel.model import Model
 from cogmap.genmodel.spec import SpecError
 from cogmap.genmodel.transitions import SparseTransitions

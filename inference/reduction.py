@@ -16,8 +16,9 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from cogmap.genmodel.spec import SpecError
 from scipy.special import gammaln
+
+from cogmap.genmodel.spec import SpecError
 
 
 class Reduction(NamedTuple):

@@ -2,6 +2,7 @@
 
 import networkx as nx
 import numpy as np
+
 from cogmap.genmodel import Factor, Modality, ModelSpec, PoseSpec, compile
 from cogmap.genmodel.graph import to_graph, write_graphml
 from cogmap.genmodel.transitions import SparseTransitions

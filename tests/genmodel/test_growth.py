@@ -3,6 +3,7 @@
 import math
 
 import numpy as np
+
 from cogmap.genmodel import Factor, Modality, ModelSpec, PoseSpec, SparseB, compile, normalise
 
 
@@ -78,6 +79,7 @@ def test_add_observation_keeps_counts_and_normalisation():
 
 def test_growth_of_fixed_factor_is_refused():
     import pytest
+
     from cogmap.genmodel import SpecError
 
     spec = ModelSpec([Factor("s", 2)], [Modality("o", 2, ("s",))], A={"o": np.eye(2)}, B={"s": np.eye(2)[:, :, None]})

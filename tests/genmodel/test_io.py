@@ -4,6 +4,7 @@ import json
 
 import numpy as np
 import pytest
+
 from cogmap.genmodel import Factor, Modality, ModelSpec, PoseSpec, compile, normalise
 from cogmap.genmodel.io import ModelFileError, load, save
 from cogmap.genmodel.transitions import SparseTransitions

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from cogmap.genmodel import Factor, Modality, ModelSpec, PoseSpec, SparseB, SpecError, compile, normalise
 
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+
 from cogmap.genmodel import Factor, Modality, ModelSpec, SpecError, compile
 from cogmap.genmodel.transitions import SparseTransitions
 from cogmap.inference.learning import (

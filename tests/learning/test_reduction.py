@@ -2,9 +2,10 @@
 
 import numpy as np
 import pytest
+from scipy.special import gammaln
+
 from cogmap.genmodel import SpecError
 from cogmap.inference.reduction import reduce_dirichlet
-from scipy.special import gammaln
 
 
 def dirichlet_multinomial_log_evidence(counts, prior):

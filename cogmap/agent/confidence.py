@@ -1,0 +1,49 @@
+"""Is the agent sure where it is? (Appendix A.1.2, made independent of the number of states.)
+
+The published test z-scores the posterior vector, which is bounded by ``sqrt(n - 1)`` and so
+can never reach the threshold 4 with fewer than 17 states. Here two scores in nats are used,
+neither of which depends on how many states exist:
+
+* ``dominance``: log-odds of the most likely state against the runner-up;
+* ``conflict``: how much better the current observation would be explained by the state that
+  explains it best than by the predicted belief, ``ln max_s A[o, s] - ln sum_s q(s) A[o, s]``.
+  It is large when a familiar observation turns up where the agent does not expect it
+  (kidnapping, large drift), and near zero for new observations or expected ones.
+
+The agent is confident when dominance >= threshold and conflict < threshold.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+TINY = 1e-300
+
+
+class Confidence(NamedTuple):
+    dominance: float
+    conflict: float
+    confident: bool
+
+
+def dominance(q: np.ndarray) -> float:
+    q = np.asarray(q, dtype=float)
+    if q.size < 2:
+        return np.inf
+    top2 = np.partition(q, -2)[-2:]
+    return float(np.log(max(top2[1], TINY)) - np.log(max(top2[0], TINY)))
+
+
+def conflict(A_row: np.ndarray, q_prior: np.ndarray) -> float:
+    """``A_row[s] = A[o, s]`` for the observed outcome over live states."""
+    A_row = np.asarray(A_row, dtype=float)
+    predicted = float(A_row @ np.asarray(q_prior, dtype=float))
+    return float(np.log(max(A_row.max(), TINY)) - np.log(max(predicted, TINY)))
+
+
+def assess(q_post: np.ndarray, q_prior: np.ndarray, A_row: np.ndarray | None, threshold: float) -> Confidence:
+    dom = dominance(q_post)
+    con = 0.0 if A_row is None else conflict(A_row, q_prior)
+    return Confidence(dom, con, dom >= threshold and con < threshold)

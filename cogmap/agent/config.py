@@ -1,0 +1,52 @@
+"""Every AIMAPP parameter in one place, with the paper's defaults (Table 6, A.1, Table 7)."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+from cogmap.inference.learning import LearningRates
+
+
+@dataclass(frozen=True)
+class AgentConfig:
+    num_headings: int = 12  # 12 headings + stay = 13 actions (Table 6)
+    influence_radius: float = 1.0  # 1 m small environments, 2 m large ones (Table 6)
+    robot_radius: float = 0.22  # physical radius: collision buffer for state creation
+    lookahead_nodes: int = 8  # at most this many new states per expansion (Table 6)
+    ssim_threshold: float = 0.65  # place recognition (Table 6)
+    mcts_depth: int = 10  # Appendix A.3
+    mcts_simulations: int = 30
+    z_threshold: float = 4.0  # confidence test (A.1.2), in nats of log-odds
+    goal_weight: float = 10.0  # preference weight on the goal observation (section 4.4)
+    gamma: float = 8.0  # policy precision (Eq. 4)
+    pose_sigma: float | None = None  # width of the pose likelihood; default influence_radius / 3
+    obstacle_margin: float = 0.1  # a direction is blocked when the sector's range < step + margin
+    inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
+    collision_preference: float = -6.0  # log-preference of a collision outcome
+    prior_count: float = 1.0  # Dirichlet count of new columns
+    learning: LearningRates = field(default_factory=LearningRates)
+    initial_capacity: int = 64
+
+    @property
+    def num_actions(self) -> int:
+        return self.num_headings + 1
+
+    @property
+    def stay(self) -> int:
+        """The stay control is the last one."""
+        return self.num_headings
+
+    @property
+    def sigma(self) -> float:
+        return self.pose_sigma if self.pose_sigma is not None else self.influence_radius / 3
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def from_dict(cls, d: dict) -> AgentConfig:
+        d = dict(d)
+        if "learning" in d and isinstance(d["learning"], dict):
+            lr = d["learning"]
+            d["learning"] = LearningRates(tuple(lr["forward"]), tuple(lr["reverse"]), lr["floor"])
+        return cls(**d)

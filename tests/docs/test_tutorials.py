@@ -1,0 +1,25 @@
+"""Every python block of the tutorials runs, in order, in one namespace per page."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+DOCS = Path(__file__).resolve().parents[2] / "docs"
+PAGES = ["tutorial-generative-model.md", "quickstart.md"]
+
+
+def blocks(page: str) -> list[str]:
+    return re.findall(r"```python\n(.*?)```", (DOCS / page).read_text(), flags=re.S)
+
+
+@pytest.mark.parametrize("page", PAGES)
+def test_page_runs(page):
+    code = blocks(page)
+    assert code, f"{page} has no python blocks"
+    namespace: dict = {}
+    for i, block in enumerate(code):
+        try:
+            exec(compile(block, f"{page}[block {i}]", "exec"), namespace)
+        except Exception as err:  # pragma: no cover - the message is the point
+            raise AssertionError(f"{page} block {i} failed: {err!r}\n{block}") from err
