@@ -57,7 +57,7 @@ class NavSim:
     """A layout in pybullet with a kinematic disc robot, LiDAR, panoramic camera, odometry."""
 
     def __init__(self, layout: Layout | str = "mini_warehouse", config: SimConfig | None = None,
-                 seed: int | None = None, layout_seed: int = 0):
+                 seed: int | None = None, layout_seed: int = 0, start=None):
         from .world import PyBulletScene
 
         self.base_layout = make_layout(layout, layout_seed) if isinstance(layout, str) else layout
@@ -65,7 +65,7 @@ class NavSim:
         self.scene = PyBulletScene(self.base_layout, self.config.robot_radius,
                                    self.config.robot_height)
         self.faults = FaultSchedule()
-        self.reset(seed)
+        self.reset(seed, start)
 
     # ----------------------------------------------------------------- lifecycle
     def reset(self, seed: int | np.random.Generator | None = None, start=None) -> np.ndarray:
