@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+
 from cogmap.genmodel import Factor, Modality, ModelSpec, compile
 
 
@@ -69,3 +70,61 @@ def brute_force_log_evidence(model, prior, obs, actions):
                 p *= model.A[m][idx]
         total += p
     return float(np.log(total))
+
+
+def brute_force_marginals(model, prior, obs, actions):
+    """Smoothed per-factor marginals p(s_t^f | o_1:T) by path enumeration (tiny models)."""
+    import itertools
+
+    F = len(model.factors)
+    sizes = model.num_states
+    joint_states = list(itertools.product(*[range(n) for n in sizes]))
+    T = len(obs)
+    out = [[np.zeros(n) for n in sizes] for _ in range(T)]
+    for path in itertools.product(joint_states, repeat=T):
+        p = np.prod([prior[f][path[0][f]] for f in range(F)])
+        for t in range(T):
+            if t > 0:
+                p *= np.prod(
+                    [model.B[f][path[t][f], path[t - 1][f], actions[t - 1][f]] for f in range(F)]
+                )
+            for m, o in enumerate(obs[t]):
+                if o is not None:
+                    p *= model.A[m][(o,) + tuple(path[t][f] for f in model.A_deps[m])]
+        for t in range(T):
+            for f in range(F):
+                out[t][f][path[t][f]] += p
+    return [[x / x.sum() for x in row] for row in out]
+
+
+def pose_model(n, seed, slots=4, num_obs=None, dense=False, growable=False):
+    """A single-factor map with 13 controls (12 headings + stay), sparse B and stored poses."""
+    from cogmap.genmodel import PoseSpec, SparseB
+
+    rng = np.random.default_rng(seed)
+    U, stay = 13, 12
+    num_obs = num_obs or max(2, n // 2)
+    succ = rng.integers(0, n, size=(n, U, slots))
+    prob = dirichlet(rng, (slots, n, U), 1.0).transpose(1, 2, 0)
+    succ[:, stay] = np.arange(n)[:, None]
+    prob[:, stay] = 0.0
+    prob[:, stay, 0] = 1.0
+    sparse = SparseB(succ=succ, prob=prob)
+    if dense:
+        from cogmap.genmodel import SparseTransitions
+
+        Bd = SparseTransitions(succ, prob).to_dense(n)
+        B = Bd
+    else:
+        B = sparse
+    A = dirichlet(rng, (num_obs, n), 0.3)
+    poses = rng.uniform(0, np.sqrt(n), size=(n, 2))
+    headings = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    spec = ModelSpec(
+        factors=[Factor("loc", n, num_controls=U, stay=stay, growable=growable)],
+        modalities=[Modality("view", num_obs, ("loc",))],
+        A={"view": A},
+        B={"loc": B},
+        pose=PoseSpec("loc", poses, headings, step=1.0, influence_radius=1.0),
+    )
+    return compile(spec)
