@@ -14,6 +14,19 @@ import numpy as np
 from .base import InferenceError, InferenceInfo, prepare
 
 
+def _log_space_update(prior, evidence, t):
+    with np.errstate(divide="ignore"):
+        logq = np.log(prior)
+        for ev in evidence:
+            logq = logq + np.log(ev.lik)
+    top = logq.max()
+    if not np.isfinite(top):
+        raise InferenceError(f"filter: observations up to step {t} have zero probability under the model")
+    q = np.exp(logq - top)
+    c = q.sum()
+    return q / c, float(top + np.log(c))
+
+
 def filter(model, prior, observations, actions=None):  # noqa: A001 - registered scheme name
     """Single-factor forward filter; ``info.free_energy`` is ``-log p(o_T | o_<T)``."""
     if len(model.factors) != 1:
@@ -29,15 +42,18 @@ def filter(model, prior, observations, actions=None):  # noqa: A001 - registered
     for t in range(prob.T):
         if t > 0:
             q = model.predict(0, q, prob.actions[t - 1][0])
+        prior_t = q
         scale = 0.0
         for ev in prob.evidence[t]:
             q = q * ev.lik
             scale += ev.log_scale
         c = q.sum()
-        if not c > 0:
-            raise InferenceError(f"filter: observations up to step {t} have zero probability under the model")
-        q = q / c
-        fe = -(float(np.log(c)) + scale)
+        if c > 0 and np.isfinite(c):
+            q = q / c
+            log_c = float(np.log(c))
+        else:  # the product underflowed: redo it in log space
+            q, log_c = _log_space_update(prior_t, prob.evidence[t], t)
+        fe = -(log_c + scale)
         total += fe
         history.append((q,))
     return [q], InferenceInfo(fe, tuple(history), 1, total)
