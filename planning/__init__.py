@@ -1,1 +1,78 @@
-"""cogmap.planning."""
+"""cogmap.planning: expected-free-energy terms, policies, MCTS, the inductive term and A*.
+
+An agent loop makes one decision with :func:`decide`::
+
+    from cogmap.planning import decide, MCTSConfig
+    d = decide(model, qs, obstacles=flags, mode="explore", rng=rng)
+    action = d.action
+
+Lower-level pieces are pure functions of arrays: :mod:`.efe` (terms, :func:`objective`,
+presets), :mod:`.policies` (enumeration, rollouts, softmax selection), :mod:`.mcts`,
+:mod:`.inductive`, :mod:`.astar`.
+"""
+
+from . import efe, inductive
+from .arrays import PlanningArrays, Prepared, from_model, prepare
+from .astar import astar_graph, astar_grid
+from .context import DenseStep, LocalStep
+from .decide import decide, make_objective
+from .efe import (
+    Objective,
+    a_novelty,
+    b_novelty,
+    collision,
+    exploration,
+    full,
+    goal,
+    objective,
+    observation_preference,
+    param_info_gain,
+    position_preference,
+    state_info_gain,
+    state_preference,
+)
+from .mcts import Decision, MCTSConfig, mcts, ucb_select
+from .policies import (
+    enumerate_policies,
+    evaluate_policies,
+    infer_policies,
+    policy_posterior,
+    select,
+)
+
+__all__ = [
+    "Decision",
+    "DenseStep",
+    "LocalStep",
+    "MCTSConfig",
+    "Objective",
+    "PlanningArrays",
+    "Prepared",
+    "a_novelty",
+    "astar_graph",
+    "astar_grid",
+    "b_novelty",
+    "collision",
+    "decide",
+    "efe",
+    "enumerate_policies",
+    "evaluate_policies",
+    "exploration",
+    "from_model",
+    "full",
+    "goal",
+    "inductive",
+    "infer_policies",
+    "make_objective",
+    "mcts",
+    "objective",
+    "observation_preference",
+    "param_info_gain",
+    "position_preference",
+    "prepare",
+    "select",
+    "policy_posterior",
+    "state_info_gain",
+    "state_preference",
+    "ucb_select",
+]

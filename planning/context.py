@@ -1,0 +1,244 @@
+"""Step contexts: what an EFE term sees for one planning step of ``K`` candidates.
+
+Both contexts expose the same attributes, computed lazily so an objective only pays for the
+terms it uses:
+
+``num_candidates``, ``actions`` (K, F), ``t``, ``qs`` (per factor, (K, n_f): predicted states),
+``qs_prev``, ``qo`` (per modality, (K, o_m)), ``ambiguity`` (per modality, (K,)),
+``a_novelty`` / ``b_novelty`` (per modality / factor, (K,) or None), ``C``, ``C_states``,
+``poses``, ``pose_factor``, ``pose_sigma``, ``target_pose``, ``collision`` ((K,) or None),
+``collision_pref``, ``closer`` ((K,) or None).
+
+:class:`DenseStep` works on full (multi-factor) beliefs, like pymdp. :class:`LocalStep` works on
+one factor with sparse transitions from a sparse prior: every array is restricted to ``U``, the
+states the candidates can reach, so its cost is independent of the size of the map.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property, lru_cache
+
+import numpy as np
+
+from . import inductive as ind
+from .arrays import Prepared
+
+_LETTERS = "abcdefghijklmnopqrstuvwxyz"
+
+
+@lru_cache(maxsize=64)
+def _subscripts(ndeps: int, keep_first: bool) -> str:
+    dims = _LETTERS[:ndeps]
+    lhs = ("o" if keep_first else "") + dims
+    ins = ",".join("K" + d for d in dims)
+    return f"{lhs},{ins}->K" + ("o" if keep_first else "")
+
+
+def expect(T: np.ndarray, qs: list[np.ndarray], keep_first: bool = False) -> np.ndarray:
+    """Contract tensor ``T`` ((o,)? x d_1 x ... x d_n) with batched factor beliefs ``qs[i]``
+    of shape (K, d_i); returns (K, o) when ``keep_first`` else (K,)."""
+    if len(qs) == 1:
+        return qs[0] @ (T.T if keep_first else T)
+    return np.einsum(_subscripts(len(qs), keep_first), T, *qs, optimize=True)
+
+
+class _Common:
+    prep: Prepared
+    collision: np.ndarray | None
+
+    @property
+    def num_candidates(self) -> int:
+        return self.actions.shape[0]
+
+    @property
+    def C(self) -> list:
+        a = self.prep.arrays
+        return [a.C[m][: a.num_obs[m]] for m in range(len(a.A))]
+
+    @property
+    def pose_factor(self) -> int:
+        return self.prep.arrays.pose_factor
+
+    @property
+    def pose_sigma(self) -> float:
+        return self.prep.arrays.pose_sigma
+
+    @property
+    def target_pose(self):
+        return self.prep.arrays.target_pose
+
+    @property
+    def collision_pref(self) -> float:
+        return self.prep.arrays.collision_pref
+
+
+class DenseStep(_Common):
+    """One step from batched beliefs ``qs_prev`` (per factor (K, n_f)) under ``actions`` (K, F)."""
+
+    def __init__(self, prep: Prepared, qs_prev: list, actions: np.ndarray, t: int = 0, collision=None):
+        self.prep = prep
+        self.actions = np.asarray(actions)
+        self.t = t
+        self.qs_prev = qs_prev
+        self.collision = collision
+        a = prep.arrays
+        self.qs = []
+        for f, q in enumerate(qs_prev):
+            B = prep.B[f]
+            u = self.actions[:, f]
+            out = np.empty_like(q)
+            for c in np.unique(u):
+                rows = u == c
+                out[rows] = q[rows] @ B[:, :, c].T
+            self.qs.append(out)
+        self._a = a
+
+    @cached_property
+    def qo(self) -> list:
+        a = self._a
+        return [expect(a.live_A(m), [self.qs[f] for f in a.A_deps[m]], True) for m in range(len(a.A))]
+
+    @cached_property
+    def ambiguity(self) -> list:
+        a = self._a
+        return [expect(self.prep.HA[m], [self.qs[f] for f in a.A_deps[m]]) for m in range(len(a.A))]
+
+    @cached_property
+    def a_novelty(self) -> list:
+        a = self._a
+        out = []
+        for m, w in enumerate(self.prep.wA):
+            if w is None:
+                out.append(None)
+            else:
+                ew = expect(w, [self.qs[f] for f in a.A_deps[m]], True)
+                out.append((self.qo[m] * ew).sum(axis=1))
+        return out
+
+    @cached_property
+    def b_novelty(self) -> list:
+        out = []
+        for f, w in enumerate(self.prep.wB):
+            if w is None:
+                out.append(None)
+                continue
+            u = self.actions[:, f]
+            v = np.empty(self.num_candidates)
+            for c in np.unique(u):
+                rows = u == c
+                v[rows] = ((self.qs[f][rows] @ w[:, :, c]) * self.qs_prev[f][rows]).sum(axis=1)
+            out.append(v)
+        return out
+
+    @property
+    def C_states(self) -> list:
+        a = self._a
+        if a.C_states is None:
+            return [None] * a.num_factors
+        return [a.C_states[f][: a.num_states[f]] for f in range(a.num_factors)]
+
+    @property
+    def poses(self):
+        a = self._a
+        return None if a.poses is None else a.poses[: a.num_states[a.pose_factor]]
+
+    @cached_property
+    def closer(self):
+        dist = self.prep.dist
+        if dist is None:
+            return None
+        f = self._a.goal_factor
+        anchor = self.qs_prev[f].argmax(axis=1)
+        return ind.closer_probability(self.qs[f], dist, dist[anchor], self._a.inductive_depth)
+
+
+class LocalStep(_Common):
+    """One step of a single sparse factor from the sparse prior ``(prior_idx, prior_p)``
+    under each control in ``actions`` (K,)."""
+
+    def __init__(self, prep: Prepared, prior_idx, prior_p, actions, t: int = 0, collision=None):
+        self.prep = prep
+        self.t = t
+        self.collision = collision
+        a = prep.arrays
+        self._a = a
+        B = a.B[0]
+        acts = np.asarray(actions, dtype=np.int64).reshape(-1)
+        self.actions = acts[:, None]
+        prior_idx = np.asarray(prior_idx, dtype=np.int64).reshape(-1)
+        prior_p = np.asarray(prior_p, dtype=float).reshape(-1)
+        self.prior_idx, self.prior_p = prior_idx, prior_p
+        K, R = acts.size, prior_idx.size
+        succ = B.succ[prior_idx[:, None], acts[None, :]]  # (R, K, k)
+        prob = B.prob[prior_idx[:, None], acts[None, :]] * prior_p[:, None, None]
+        self._succ, self._prob = succ, prob
+        U, inv = np.unique(succ, return_inverse=True)
+        inv = inv.reshape(succ.shape)
+        self.U = U
+        self._inv = inv
+        nU = U.size
+        flat = (np.arange(K)[None, :, None] * nU + inv).ravel()
+        qs = np.bincount(flat, weights=prob.ravel(), minlength=K * nU).reshape(K, nU)
+        self.qs = [qs]
+        # the prior, as a (K, R) batch over its own support
+        self.qs_prev = [np.broadcast_to(prior_p, (K, R))]
+
+    @cached_property
+    def _cols(self):
+        return self.prep.columns(self.U)
+
+    @cached_property
+    def qo(self) -> list:
+        a = self._a
+        return [self.qs[0] @ a.A[m][: a.num_obs[m], self.U].T for m in range(len(a.A))]
+
+    @cached_property
+    def ambiguity(self) -> list:
+        return [self.qs[0] @ h for h in self._cols[0]]
+
+    @cached_property
+    def a_novelty(self) -> list:
+        out = []
+        for m, w in enumerate(self._cols[1]):
+            out.append(None if w is None else (self.qo[m] * (self.qs[0] @ w.T)).sum(axis=1))
+        return out
+
+    @cached_property
+    def b_novelty(self) -> list:
+        B = self._a.B[0]
+        if getattr(B, "counts", None) is None:
+            return [None]
+        from .efe import novelty_weights
+
+        acts = self.actions[:, 0]
+        counts = B.counts[self.prior_idx[:, None], acts[None, :]]  # (R, K, k)
+        w = novelty_weights(counts, axis=2)
+        K = acts.size
+        qn = self.qs[0][np.arange(K)[None, :, None], self._inv]  # predicted prob of each slot
+        v = (self.prior_p[:, None, None] * qn * w).sum(axis=(0, 2))
+        return [v]
+
+    @cached_property
+    def C_states(self) -> list:
+        a = self._a
+        return [None if a.C_states is None else a.C_states[0][self.U]]
+
+    @cached_property
+    def poses(self):
+        a = self._a
+        return None if a.poses is None else a.poses[self.U]
+
+    @cached_property
+    def closer(self):
+        dist = self.prep.dist
+        if dist is None:
+            return None
+        anchor = self.prior_idx[self.prior_p.argmax()]
+        K = self.num_candidates
+        return ind.closer_probability(
+            self.qs[0], dist[self.U], np.full(K, dist[anchor]), self._a.inductive_depth
+        )
+
+    def most_likely(self) -> np.ndarray:
+        """Most likely next state per candidate."""
+        return self.U[self.qs[0].argmax(axis=1)]

@@ -1,0 +1,67 @@
+"""One decision for an agent loop: model + belief + obstacle signal + mode -> action."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from . import efe
+from .arrays import PlanningArrays, from_model, prepare
+from .mcts import Decision, MCTSConfig, mcts
+
+MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full}
+
+
+def make_objective(mode, inductive_weight: float | None = None) -> efe.Objective:
+    """``mode`` is "explore", "goal", "full" or an :class:`~.efe.Objective`."""
+    if isinstance(mode, efe.Objective):
+        return mode
+    if mode not in MODES:
+        raise ValueError(f"unknown planning mode '{mode}' (known: {sorted(MODES)} or an Objective)")
+    if mode in ("goal", "full") and inductive_weight is not None:
+        return MODES[mode](inductive_weight=inductive_weight)
+    return MODES[mode]()
+
+
+def decide(
+    model,
+    qs,
+    obstacles=None,
+    mode="explore",
+    *,
+    target_pose=None,
+    goal_states=None,
+    config: MCTSConfig | None = None,
+    rng: np.random.Generator | int | None = None,
+) -> Decision:
+    """Choose the next control by MCTS over EFE.
+
+    ``model`` is a compiled ``cogmap.genmodel.Model`` or :class:`PlanningArrays`; ``qs`` the
+    current belief (a list per factor, or one array for a single factor); ``obstacles`` one
+    bool per control of the moving factor (True: obstacle in that direction); ``mode``
+    "explore", "goal", "full" or a custom objective. Depth and simulations default to the
+    model's inductive depth and 30.
+    """
+    if isinstance(model, PlanningArrays):
+        arrays = model
+        if target_pose is not None or goal_states is not None:
+            arrays = replace(
+                arrays,
+                target_pose=arrays.target_pose if target_pose is None else np.asarray(target_pose, float),
+                goal_states=arrays.goal_states if goal_states is None else np.asarray(goal_states),
+            )
+        ind_w = None
+    else:
+        arrays = from_model(model, target_pose=target_pose, goal_states=goal_states)
+        ind_w = None if model.inductive is None else float(model.inductive.weight)
+    if isinstance(qs, np.ndarray) and qs.ndim == 1:
+        qs = [qs]
+    obj = make_objective(mode, ind_w)
+    cfg = config or MCTSConfig(depth=arrays.inductive_depth)
+    prep = prepare(
+        arrays,
+        need_novelty=obj.uses(efe.param_info_gain) or obj.uses(efe.a_novelty) or obj.uses(efe.b_novelty),
+        need_goal=obj.uses(efe.inductive),
+    )
+    return mcts(prep, qs, obj, obstacles, cfg, rng)

@@ -1,0 +1,259 @@
+"""Monte Carlo tree search over expected free energy (Appendix A.3).
+
+Each simulation descends from the root for ``depth`` steps. At a node, the candidate actions
+are the ones allowed there (moves with possible transitions; at the root, not flagged by the
+obstacle signal); their one-step EFE ``g`` is computed once, in a batch, when the node is
+expanded. Selection is UCB on the values: children not yet tried are tried first, best
+immediate EFE first; after that, the child maximising ``(Q_max - Q) / (Q_max - Q_min) +
+c sqrt(ln N / n)`` with ``Q`` the mean cumulative EFE backed up through it. The cumulative EFE
+of the path below each edge is backed up along the path. The decision is a softmax with
+precision ``gamma`` over the mean cumulative EFE of the root children (Eq. 4), taken by argmax
+or sampled with the given ``numpy.random.Generator``; the search is deterministic given it.
+
+Two expanders share this core:
+
+* :class:`LocalExpander`: a single factor with sparse transitions (the topological map). Below
+  the root a node is the most likely state; its expansion reads only the sparse columns of that
+  state, so cost is independent of the map size. Expansions are shared through a transposition
+  table keyed by the discrete state; visit statistics are keyed by ``(state, depth)`` so values
+  of different remaining horizons are not mixed (``share="state"`` keys them by state only).
+* :class:`BeliefExpander`: full (multi-factor) beliefs rolled forward exactly as policy
+  enumeration does, with nodes shared by identical beliefs; with enough simulations it agrees
+  with exhaustive enumeration.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .arrays import Prepared
+from .context import DenseStep, LocalStep
+from .efe import Objective
+from .policies import enumerate_policies, softmax
+
+
+@dataclass(frozen=True)
+class MCTSConfig:
+    depth: int = 10
+    simulations: int = 30
+    c: float = 1.0  # UCB exploration constant (values are min-max normalised per node)
+    gamma: float = 16.0  # precision of the decision softmax
+    sample: bool = False  # sample the decision instead of argmax
+    prune_obstacles: bool = True  # do not expand root moves flagged by the obstacle signal
+    move_threshold: float = 0.0  # a move is allowed when P(leave the state) exceeds this
+    share: str = "state_depth"  # key of visit statistics: "state_depth" or "state"
+    support_tol: float = 1e-9  # root belief entries below tol * max are dropped (local path)
+
+
+class Node:
+    __slots__ = ("actions", "g", "child", "n", "w", "N", "tie")
+
+    def __init__(self, actions, g, child, tie):
+        self.actions = actions
+        self.g = g
+        self.child = child
+        self.n = np.zeros(len(g))
+        self.w = np.zeros(len(g))
+        self.N = 0
+        self.tie = tie
+
+
+def ucb_select(n: np.ndarray, w: np.ndarray, g: np.ndarray, N: int, c: float, tie=None) -> int:
+    """UCB over EFE. Untried children first (lowest immediate EFE ``g``); then the child
+    maximising the normalised value ``(Q_max - Q) / (Q_max - Q_min)`` plus
+    ``c sqrt(ln N / n)``, where ``Q = w / n`` is the mean cumulative EFE (lower is better)."""
+    tie = 0.0 if tie is None else tie
+    untried = n == 0
+    if untried.any():
+        return int(np.argmin(np.where(untried, g + tie, np.inf)))
+    Q = w / n
+    lo, hi = Q.min(), Q.max()
+    span = hi - lo if hi > lo else 1.0
+    score = (hi - Q) / span + c * np.sqrt(math.log(max(N, 1)) / n) - tie
+    return int(np.argmax(score))
+
+
+@dataclass
+class Decision:
+    action: int | tuple  # control (or tuple of controls per factor) to execute
+    actions: np.ndarray  # root candidate controls
+    probs: np.ndarray  # decision distribution over root candidates
+    Q: np.ndarray  # mean cumulative EFE per root candidate (nan if never visited)
+    visits: np.ndarray
+    G_first: np.ndarray  # one-step EFE per root candidate
+    info: dict = field(default_factory=dict)
+
+
+def allowed_actions(B, s: int, stay: int | None, threshold: float = 0.0) -> np.ndarray:
+    """Controls at state ``s`` of a sparse B whose transitions can leave ``s`` (plus stay)."""
+    succ, prob = B.succ[s], B.prob[s]
+    leave = (prob * (succ != s)).sum(axis=1) > threshold
+    if stay is not None:
+        leave[stay] = True
+    acts = np.flatnonzero(leave)
+    return acts if acts.size else np.arange(succ.shape[0])
+
+
+class LocalExpander:
+    """Expansion on a single sparse factor (see module docstring)."""
+
+    def __init__(self, prep: Prepared, objective: Objective, prior_idx, prior_p, obstacles, cfg):
+        self.prep, self.objective, self.cfg = prep, objective, cfg
+        a = prep.arrays
+        self.B = a.B[0]
+        self.stay = None if a.stay is None else a.stay[0]
+        p = np.asarray(prior_p, dtype=float)
+        self.prior_idx = np.asarray(prior_idx, dtype=np.int64)
+        self.prior_p = p / p.sum()
+        self.obstacles = None if obstacles is None else np.asarray(obstacles, dtype=float)
+        self.cache: dict = {}
+        self.expansions = 0
+
+    def root(self):
+        anchor = int(self.prior_idx[self.prior_p.argmax()])
+        acts = allowed_actions(self.B, anchor, self.stay, self.cfg.move_threshold)
+        coll = None
+        if self.obstacles is not None:
+            if self.cfg.prune_obstacles:
+                free = acts[self.obstacles[acts] <= 0.0]
+                if free.size:
+                    acts = free
+            coll = self.obstacles[acts]
+        ctx = LocalStep(self.prep, self.prior_idx, self.prior_p, acts, 0, coll)
+        self.expansions += 1
+        return acts, self.objective(ctx), ctx.most_likely().tolist()
+
+    def expand(self, s: int):
+        hit = self.cache.get(s)
+        if hit is None:
+            acts = allowed_actions(self.B, s, self.stay, self.cfg.move_threshold)
+            ctx = LocalStep(self.prep, (s,), (1.0,), acts, 1, None)
+            hit = (acts, self.objective(ctx), ctx.most_likely().tolist())
+            self.cache[s] = hit
+            self.expansions += 1
+        return hit
+
+
+class BeliefExpander:
+    """Expansion on full factor beliefs (dense), nodes shared by identical beliefs."""
+
+    def __init__(self, prep: Prepared, objective: Objective, qs, obstacles, cfg):
+        self.prep, self.objective, self.cfg = prep, objective, cfg
+        a = prep.arrays
+        self.controls = enumerate_policies(a.num_controls, 1)[:, 0, :]
+        self.obstacles = None if obstacles is None else np.asarray(obstacles, dtype=float)
+        self.beliefs: list = []
+        self.ids: dict = {}
+        self.cache: dict = {}
+        self.expansions = 0
+        self.root_q = [np.asarray(q, dtype=float)[: a.num_states[f]] for f, q in enumerate(qs)]
+
+    def _key(self, qs) -> int:
+        h = b"".join(np.round(q, 12).tobytes() for q in qs)
+        k = self.ids.get(h)
+        if k is None:
+            k = len(self.beliefs)
+            self.ids[h] = k
+            self.beliefs.append(qs)
+        return k
+
+    def _step(self, qs, acts, coll):
+        K = len(acts)
+        ctx = DenseStep(self.prep, [np.broadcast_to(q, (K, q.size)) for q in qs], acts, 0, coll)
+        g = self.objective(ctx)
+        kids = [self._key([q[k] for q in ctx.qs]) for k in range(K)]
+        self.expansions += 1
+        return acts, g, kids
+
+    def root(self):
+        acts = self.controls
+        coll = None
+        if self.obstacles is not None:
+            cf = self.prep.arrays.control_factor
+            if self.cfg.prune_obstacles:
+                free = acts[self.obstacles[acts[:, cf]] <= 0.0]
+                if len(free):
+                    acts = free
+            coll = self.obstacles[acts[:, cf]]
+        return self._step(self.root_q, acts, coll)
+
+    def expand(self, key: int):
+        hit = self.cache.get(key)
+        if hit is None:
+            hit = self._step(self.beliefs[key], self.controls, None)
+            self.cache[key] = hit
+        return hit
+
+
+def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> Decision:
+    """Run ``cfg.simulations`` simulations of ``cfg.depth`` steps and decide."""
+    acts, g, kids = expander.root()
+    root = Node(acts, g, kids, rng.random(len(g)) * 1e-9)
+    nodes: dict = {}
+    by_state = cfg.share == "state"
+    for _ in range(cfg.simulations):
+        node = root
+        path = []
+        for d in range(cfg.depth):
+            i = ucb_select(node.n, node.w, node.g, node.N, cfg.c, node.tie)
+            path.append((node, i))
+            if d + 1 == cfg.depth:
+                break
+            key = node.child[i]
+            nk = key if by_state else (key, d + 1)
+            nxt = nodes.get(nk)
+            if nxt is None:
+                a2, g2, k2 = expander.expand(key)
+                nxt = Node(a2, g2, k2, rng.random(len(g2)) * 1e-9)
+                nodes[nk] = nxt
+            node = nxt
+        ret = 0.0
+        for node, i in reversed(path):
+            ret += node.g[i]
+            node.n[i] += 1.0
+            node.w[i] += ret
+            node.N += 1
+    visited = root.n > 0
+    Q = np.full(len(root.g), np.nan)
+    Q[visited] = root.w[visited] / root.n[visited]
+    probs = np.zeros(len(root.g))
+    if visited.any():
+        probs[visited] = softmax(-cfg.gamma * Q[visited])
+    else:
+        probs[int(np.argmin(root.g))] = 1.0
+    i = int(rng.choice(len(probs), p=probs)) if cfg.sample else int(np.argmax(probs))
+    a = root.actions[i]
+    action = int(a) if np.ndim(a) == 0 else tuple(int(x) for x in a)
+    return Decision(
+        action=action,
+        actions=root.actions,
+        probs=probs,
+        Q=Q,
+        visits=root.n.copy(),
+        G_first=root.g,
+        info={"nodes": len(nodes) + 1, "expansions": getattr(expander, "expansions", None)},
+    )
+
+
+def mcts(
+    prep: Prepared,
+    qs,
+    objective: Objective,
+    obstacles=None,
+    config: MCTSConfig | None = None,
+    rng: np.random.Generator | int | None = None,
+) -> Decision:
+    """MCTS decision from belief ``qs`` (list per factor). With a local preparation (one
+    sparse factor) the tree works on states; otherwise on full beliefs."""
+    cfg = config or MCTSConfig()
+    rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
+    if prep.local:
+        q = np.asarray(qs[0], dtype=float)[: prep.arrays.num_states[0]]
+        idx = np.flatnonzero(q > cfg.support_tol * q.max())
+        expander = LocalExpander(prep, objective, idx, q[idx], obstacles, cfg)
+    else:
+        expander = BeliefExpander(prep, objective, qs, obstacles, cfg)
+    return search(expander, cfg, rng)
