@@ -71,12 +71,23 @@ def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_
         lik, scale = _joint_likelihood(prob.evidence[t], sizes)
         post = alpha * lik
         c = post.sum()
-        if not c > 0:
-            raise InferenceError(f"exact: observations up to step {t} have zero probability under the model")
+        if c > 0 and np.isfinite(c):
+            log_c_t = float(np.log(c))
+        else:  # the product underflowed: redo it in log space
+            with np.errstate(divide="ignore"):
+                log_post = np.log(alpha) + np.log(lik)
+            top = log_post.max()
+            if not np.isfinite(top):
+                raise InferenceError(
+                    f"exact: observations up to step {t} have zero probability under the model"
+                )
+            post = np.exp(log_post - top)
+            c = post.sum()
+            log_c_t = float(top + np.log(c))
         alpha = post / c
-        log_c.append(np.log(c) + scale)
+        log_c.append(log_c_t + scale)
         alphas.append(alpha)
-        liks.append(lik / c)
+        liks.append(lik)
     if smooth:
         beta = np.ones(sizes)
         gammas = [alphas[-1]]
@@ -84,7 +95,7 @@ def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_
             x = liks[t + 1] * beta
             for f in range(F):
                 x = _apply(mats[t][f], x, f, transpose=True)
-            beta = x
+            beta = x / x.max()  # only the shape of beta matters
             g = alphas[t] * beta
             gammas.append(g / g.sum())
         gammas.reverse()
