@@ -74,7 +74,7 @@ def nauc(distances, coverages, budget: float) -> float:
     c = np.asarray(coverages, dtype=float)
     if budget <= 0 or d.size == 0:
         raise ValueError("nauc needs a positive budget and at least one sample")
-    if np.any(np.diff(d) < 0):
+    if np.any(np.diff(d) < -1e-9):
         raise ValueError("distances must be non-decreasing")
     edges = np.clip(np.append(d, budget), 0, budget)
     widths = np.diff(edges)

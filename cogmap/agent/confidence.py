@@ -10,7 +10,11 @@ neither of which depends on how many states exist:
   It is large when a familiar observation turns up where the agent does not expect it
   (kidnapping, large drift), and near zero for new observations or expected ones.
 
-The agent is confident when dominance >= threshold and conflict < threshold.
+Conflict is a log-likelihood ratio ("the observation comes from somewhere else" against "it
+comes from where I believe I am"), so the agent declares itself *lost* with a CUSUM test on it:
+``S_t = max(0, S_t-1 + conflict_t - slack)`` fires when ``S_t >= threshold``. A single odd
+view (aliasing, a changed scene) does not fire it; a run of them (kidnapping, severe drift)
+does. The agent is *confident* when dominance >= threshold and it is not lost.
 """
 
 from __future__ import annotations
@@ -23,9 +27,13 @@ TINY = 1e-300
 
 
 class Confidence(NamedTuple):
-    dominance: float
-    conflict: float
+    dominance: float  # nats by which the most likely state beats the runner-up
+    conflict: float  # nats by which the observation is better explained elsewhere
+    lost_evidence: float  # CUSUM of conflict after this step
     confident: bool
+
+    def lost(self, threshold: float) -> bool:
+        return self.lost_evidence >= threshold
 
 
 def dominance(q: np.ndarray) -> float:
@@ -43,7 +51,15 @@ def conflict(A_row: np.ndarray, q_prior: np.ndarray) -> float:
     return float(np.log(max(A_row.max(), TINY)) - np.log(max(predicted, TINY)))
 
 
-def assess(q_post: np.ndarray, q_prior: np.ndarray, A_row: np.ndarray | None, threshold: float) -> Confidence:
+def cusum(previous: float, conflict_value: float, slack: float = 1.0) -> float:
+    """One step of the CUSUM statistic on conflict (nats)."""
+    return max(0.0, previous + conflict_value - slack)
+
+
+def assess(q_post: np.ndarray, q_prior: np.ndarray, A_row: np.ndarray | None, threshold: float,
+           evidence: float = 0.0, slack: float = 1.0) -> Confidence:
+    """Scores for one step; ``evidence`` is the CUSUM statistic before this step."""
     dom = dominance(q_post)
     con = 0.0 if A_row is None else conflict(A_row, q_prior)
-    return Confidence(dom, con, dom >= threshold and con < threshold)
+    lost = cusum(evidence, con, slack)
+    return Confidence(dom, con, lost, dom >= threshold and lost < threshold)

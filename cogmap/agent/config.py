@@ -12,6 +12,7 @@ class AgentConfig:
     num_headings: int = 12  # 12 headings + stay = 13 actions (Table 6)
     influence_radius: float = 1.0  # 1 m small environments, 2 m large ones (Table 6)
     robot_radius: float = 0.22  # physical radius: collision buffer for state creation
+    node_spacing: float = 0.9  # a predicted pose is beyond a node's influence past this x radius
     lookahead_nodes: int = 8  # at most this many new states per expansion (Table 6)
     ssim_threshold: float = 0.65  # place recognition (Table 6)
     mcts_depth: int = 10  # Appendix A.3
@@ -23,7 +24,10 @@ class AgentConfig:
     obstacle_margin: float = 0.1  # a direction is blocked when the sector's range < step + margin
     inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
     collision_preference: float = -6.0  # log-preference of a collision outcome
-    prior_count: float = 1.0  # Dirichlet count of new columns
+    prior_count: float = 0.1  # Dirichlet count of each outcome in a new column
+    obs_learning_rate: float = 1.0  # counts added when an observation is tied to a state (Table 6)
+    relocalise_ssim: float = 0.9  # a recognised view this similar re-localises the metric pose
+    lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)
     learning: LearningRates = field(default_factory=LearningRates)
     initial_capacity: int = 64
 

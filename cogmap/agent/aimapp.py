@@ -1,0 +1,261 @@
+"""The AIMAPP agent: one thin stateful shell over the pure pieces (sections 3.1-3.6).
+
+Each :meth:`AIMAPPAgent.step` runs sense -> infer -> learn -> plan and returns where to go:
+
+1. *sense*: the panorama becomes an observation id through the encoder (a new id grows A_o);
+   the believed pose is odometry plus the correction of the last re-localisation.
+2. *infer*: the single-factor filter combines the B_s prediction of the last move with A_o
+   and A_p evidence; the confidence test decides whether the result can be trusted.
+3. *learn* (confident only): A_o associates the observation with the believed state, a
+   recognised place re-localises the pose, the executed or failed move updates B_s with the
+   Table 7 rates, the obstacle signal adds predicted (im)possible transitions, and free
+   directions beyond every node's influence radius expand the map when Eq. (7) says so.
+4. *plan*: MCTS over expected free energy (exploration or goal mode, inductive term on in goal
+   mode); when not confident the agent seeks familiar observations instead (re-localisation).
+
+Sensor dropouts (``None`` inputs) pause every update: the agent stays and resumes with the same
+model and beliefs when data returns.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cogmap.genmodel import Factor, Modality, Model, ModelSpec, PoseSpec, SparseB, compile
+from cogmap.inference import filter as bayes_filter
+from cogmap.inference.learning import Event, learn_observation, learn_transition
+
+from . import planner
+from .confidence import Confidence, assess
+from .config import AgentConfig
+from .encoder import Encoder, SSIMEncoder
+from .mapping import direction, expansion_free_energy, reverse_heading
+
+
+@dataclass
+class Sensed:
+    """What the robot reports at one step; ``None`` marks a stream that did not report."""
+
+    panorama: np.ndarray | None
+    obstacles: np.ndarray | None  # one bool per heading: obstacle within reach
+    odometry: np.ndarray | None  # (x, y, yaw) in the odometry frame
+    moved: bool | None = None  # outcome of the last motion command (None: no command)
+
+
+@dataclass
+class Decision:
+    action: int
+    waypoint: np.ndarray  # odometry frame
+    state: int
+    target: int  # state the move is expected to reach (== state for stay / unknown)
+    mode: str  # "explore", "goal", "relocalise" or "paused"
+    confidence: Confidence | None = None
+    expanded: int = 0
+    efe: dict = field(default_factory=dict)
+
+
+def initial_model(cfg: AgentConfig, pose0) -> Model:
+    """One state at the start pose, one observation slot, nothing learnt."""
+    u = cfg.num_actions
+    headings = 2 * np.pi * np.arange(cfg.num_headings) / cfg.num_headings
+    succ = np.zeros((1, u, 2), dtype=int)
+    prob = np.zeros((1, u, 2))
+    prob[:, :, 0] = 1.0
+    spec = ModelSpec(
+        factors=[Factor("place", 1, num_controls=u, growable=True, capacity=cfg.initial_capacity, stay=cfg.stay)],
+        modalities=[Modality("view", 1, ("place",), growable=True, capacity=cfg.initial_capacity)],
+        A={"view": np.ones((1, 1))},
+        pA={"view": np.full((1, 1), cfg.prior_count)},
+        B={"place": SparseB(succ, prob)},
+        pB={"place": np.full((1, 1, u), cfg.prior_count)},
+        pose=PoseSpec("place", np.asarray(pose0, dtype=float)[None, :2], headings, cfg.influence_radius,
+                      cfg.influence_radius, cfg.sigma),
+    )
+    return compile(spec, prior_count=cfg.prior_count)
+
+
+class AIMAPPAgent:
+    """Owns the model, beliefs, pose correction, encoder and RNG; contains no maths."""
+
+    def __init__(self, config: AgentConfig | None = None, encoder: Encoder | None = None, seed: int = 0,
+                 model: Model | None = None):
+        self.cfg = config or AgentConfig()
+        self.encoder = encoder if encoder is not None else SSIMEncoder(self.cfg.ssim_threshold)
+        self.rng = np.random.default_rng(seed)
+        self.model = model
+        self.q: np.ndarray | None = None
+        self.offset = np.zeros(2)  # believed pose = odometry + offset
+        self.last: Decision | None = None
+        self.goal_obs: int | None = None
+        self.step_count = 0
+        self.lost_steps = 0
+        self._outcome: bool | None = None  # reported outcome of the last real motion command
+        self.lost = False  # the confidence test fired: re-localising
+        self.lost_evidence = 0.0  # CUSUM statistic of conflict
+        self.lost_events = 0
+        self.relocalisations = 0
+
+    # -- public ------------------------------------------------------------------------------
+    @property
+    def num_states(self) -> int:
+        return 0 if self.model is None else self.model.num_states[0]
+
+    @property
+    def poses(self) -> np.ndarray:
+        return self.model.pose.poses[: self.num_states]
+
+    def believed_pose(self, odometry) -> np.ndarray:
+        return np.asarray(odometry, dtype=float)[:2] + self.offset
+
+    def set_goal(self, obs: int | None) -> None:
+        """Prefer observation ``obs`` (goal mode), or return to exploration with ``None``."""
+        if obs is not None and not 0 <= obs < self.model.num_obs[0]:
+            raise ValueError(f"goal observation {obs} is unknown (have {self.model.num_obs[0]})")
+        self.goal_obs = obs
+
+    def goal_states(self, min_prob: float = 0.5) -> np.ndarray:
+        """States whose observation model favours the goal observation."""
+        if self.goal_obs is None:
+            return np.zeros(0, dtype=int)
+        row = self.model.live_A(0)[self.goal_obs]
+        return np.flatnonzero(row >= max(min_prob * row.max(), 1e-9))
+
+    def step(self, sensed: Sensed) -> Decision:
+        self.step_count += 1
+        if self.last is not None and self._outcome is None and sensed.moved is not None:
+            self._outcome = bool(sensed.moved)
+        if sensed.panorama is None or sensed.odometry is None or sensed.obstacles is None:
+            state = -1 if self.last is None else self.last.state
+            here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
+            return Decision(self.cfg.stay, here, state, state, "paused")
+        cfg = self.cfg
+        pose = self.believed_pose(sensed.odometry)
+        if self.model is None:
+            self.model = initial_model(cfg, pose)
+            self.q = np.ones(1)
+        obs, _ = self.encoder(sensed.panorama)
+        score = float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
+        while self.model.num_obs[0] <= obs:
+            self.model.add_observation(0)
+        prior = self._prior(self._outcome)
+        if self.lost:
+            # Re-localisation: odometry is not trusted, only what is seen (section 3.3).
+            q, _ = bayes_filter(self.model, [prior], [{"view": obs}])
+        else:
+            q, _ = bayes_filter(self.model, [prior], [{"view": obs, "pose": pose}])
+        q = q[0]
+        conf = assess(q, prior, self.model.live_A(0)[obs], cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
+        state = int(np.argmax(q))
+        expanded = 0
+        if self.lost:
+            if conf.dominance >= cfg.z_threshold and self._recognised(state, obs):
+                self.lost, self.lost_evidence = False, 0.0
+                self.offset += self.poses[state] - pose  # found again: trust the map's pose
+                self.relocalisations += 1
+        elif conf.lost(cfg.z_threshold):
+            self.lost, self.lost_evidence = True, 0.0
+            self.lost_events += 1
+            q = self._visited_prior()
+        else:
+            self.lost_evidence = conf.lost_evidence
+            if conf.confident:
+                expanded = self._learn(state, obs, sensed, pose, score)
+            else:  # unsure between nearby states: learn A_o under the posterior (Eq. 8 weights by Q(s))
+                learn_observation(self.model, 0, obs, [q], lr=cfg.obs_learning_rate)
+        self.q = np.zeros(self.num_states)
+        self.q[: q.size] = q
+        state = int(np.argmax(self.q))
+        if self.lost:
+            mode = "relocalise"
+        else:
+            mode = "goal" if self.goal_obs is not None else "explore"
+        action, efe = planner.decide(self, state, sensed.obstacles, mode)
+        target, waypoint = self._waypoint(state, action)
+        decision = Decision(action, waypoint - self.offset, state, target, mode, conf, expanded, efe)
+        self.last = decision
+        self._outcome = None
+        return decision
+
+    # -- pieces ------------------------------------------------------------------------------
+    def _prior(self, moved: bool | None) -> np.ndarray:
+        """Predicted belief after the last move (Eq. 1: B_s applied to the last posterior)."""
+        n = self.num_states
+        q = np.zeros(n)
+        q[: self.q.size] = self.q
+        last = self.last
+        if last is None or last.action == self.cfg.stay:
+            return q
+        if moved is False:  # blocked: the robot stopped near where it started
+            if last.target != last.state:
+                learn_transition(self.model, 0, last.state, last.action, last.target, Event.IMPOSSIBLE,
+                                 reverse_control=self._reverse(last.action), rates=self.cfg.learning)
+            return q
+        return self.model.predict(0, q, last.action)
+
+    def _reverse(self, action: int) -> int | None:
+        return reverse_heading(action, self.cfg.num_headings) if action != self.cfg.stay else None
+
+    def _recognised(self, state: int, obs: int) -> bool:
+        """``obs`` has been tied to ``state`` before and to no other state as strongly."""
+        m = self.model
+        counts = m.live_pA(0)[obs]
+        return counts[state] > 2 * self.cfg.prior_count and counts.argmax() == state
+
+    def _visited_prior(self) -> np.ndarray:
+        visited = self.model.live_pA(0).max(axis=0) > 2 * self.cfg.prior_count
+        return visited / visited.sum() if visited.any() else np.full(self.num_states, 1.0 / self.num_states)
+
+    def _learn(self, state: int, obs: int, sensed: Sensed, pose: np.ndarray, score: float) -> int:
+        m, cfg = self.model, self.cfg
+        onehot = np.zeros(self.num_states)
+        onehot[state] = 1.0
+        if self._recognised(state, obs) and score >= cfg.relocalise_ssim:
+            # a familiar view, nearly identical: re-localise the metric pose on it (drift correction)
+            self.offset += self.poses[state] - pose
+        learn_observation(m, 0, obs, [onehot], lr=cfg.obs_learning_rate)
+        last = self.last
+        arrived = last is None or state != last.state
+        if last is not None and self._outcome and state != last.state and last.action != cfg.stay:
+            learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
+                             reverse_control=self._reverse(last.action), rates=cfg.learning)
+        if not arrived:
+            return 0
+        return self._expand(state, np.asarray(sensed.obstacles, dtype=bool))
+
+    def _expand(self, state: int, obstacles: np.ndarray) -> int:
+        """Predicted transitions from the obstacle signal and Eq. (7) map expansion."""
+        m, cfg = self.model, self.cfg
+        created = 0
+        origin = self.poses[state].copy()
+        for h in range(cfg.num_headings):
+            p_star = origin + cfg.influence_radius * direction(h, cfg.num_headings)
+            exp = expansion_free_energy(p_star, self.poses, cfg.node_spacing * cfg.influence_radius, cfg.sigma)
+            rev = reverse_heading(h, cfg.num_headings)
+            if obstacles[h]:
+                if exp.nearest >= 0 and exp.nearest != state and exp.distance < cfg.influence_radius:
+                    learn_transition(m, 0, state, h, exp.nearest, Event.PREDICTED_IMPOSSIBLE,
+                                     reverse_control=rev, rates=cfg.learning)
+                continue
+            if exp.expand and created < cfg.lookahead_nodes:
+                new = m.add_state(0, pose=p_star)
+                created += 1
+                learn_transition(m, 0, state, h, new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
+                                 rates=cfg.learning)
+            elif not exp.expand and exp.nearest != state:
+                learn_transition(m, 0, state, h, exp.nearest, Event.PREDICTED_POSSIBLE, reverse_control=rev,
+                                 rates=cfg.learning)
+        return created
+
+    def _waypoint(self, state: int, action: int) -> tuple[int, np.ndarray]:
+        """Where an action leads: the believed successor node, or one step in its heading."""
+        cfg = self.cfg
+        if action == cfg.stay:
+            return state, self.poses[state].copy()
+        B = self.model.B[0]
+        k = int(np.argmax(B.prob[state, action]))
+        target = int(B.succ[state, action, k])
+        if target != state and B.prob[state, action, k] > 0.5:
+            return target, self.poses[target].copy()
+        return state, self.poses[state] + cfg.influence_radius * direction(action, cfg.num_headings)

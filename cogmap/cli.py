@@ -1,0 +1,83 @@
+"""Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def _explore(args) -> int:
+    from .explore import explore
+
+    out = Path(args.out)
+    metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet)
+    print(json.dumps(metrics, indent=1))
+    print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
+    return 0
+
+
+def _goal(args) -> int:
+    from .goal import reach_goal
+
+    result = reach_goal(Path(args.run), goal_image=args.goal_image, goal_obs=args.goal_obs, steps=args.steps,
+                        seed=args.seed, out=Path(args.out) if args.out else None, progress=not args.quiet)
+    print(json.dumps(result, indent=1))
+    return 0 if result["reached"] else 1
+
+
+def _compare(args) -> int:
+    import numpy as np
+
+    from .compare import compare_inference, format_table, generate_sequence
+    from .demo_models import MODELS
+
+    if args.model not in MODELS:
+        print(f"unknown model {args.model!r}; choose from {sorted(MODELS)}", file=sys.stderr)
+        return 2
+    model = MODELS[args.model](np.random.default_rng(args.seed))
+    seq = generate_sequence(model, T=args.steps, seed=args.seed)
+    rows = compare_inference(model, seq.observations, seq.actions, true_states=seq.states)
+    print(format_table(rows))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="cogmap", description="Active-inference navigation toolkit")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
+    e.add_argument("--env", default="mini_warehouse", help="layout name or registered id (default: mini_warehouse)")
+    e.add_argument("--steps", type=int, default=150, help="number of decisions (default: 150)")
+    e.add_argument("--seed", type=int, default=0)
+    e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
+    e.add_argument("--quiet", action="store_true", help="no progress bar")
+    e.set_defaults(func=_explore)
+
+    g = sub.add_parser("goal", help="reach a goal observation with a model from an exploration run")
+    g.add_argument("--run", required=True, help="directory written by 'cogmap explore'")
+    src = g.add_mutually_exclusive_group(required=True)
+    src.add_argument("--goal-image", help="PNG of the goal panorama")
+    src.add_argument("--goal-obs", type=int, help="id of a stored observation (observations/NNNN.png)")
+    g.add_argument("--steps", type=int, default=60)
+    g.add_argument("--seed", type=int, default=0)
+    g.add_argument("--out", default=None, help="directory for the goal run (default: <run>/goal)")
+    g.add_argument("--quiet", action="store_true")
+    g.set_defaults(func=_goal)
+
+    c = sub.add_parser("compare-inference", help="run every registered inference scheme on one model")
+    c.add_argument("--model", default="tmaze", help="built-in model: tmaze, corridor or random")
+    c.add_argument("--steps", type=int, default=30)
+    c.add_argument("--seed", type=int, default=0)
+    c.set_defaults(func=_compare)
+    return p
+
+
+def main(argv=None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

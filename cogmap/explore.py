@@ -1,0 +1,192 @@
+"""Run an AIMAPP agent in a pybullet room and write a run directory.
+
+The run directory holds ``run.json`` (config, seed, versions, commit), the model
+(``model.npz`` + ``model.json``), the cognitive map (``map.graphml``), the observations
+(``observations/*.png``), ``trajectory.csv`` (true pose, odometry, believed pose, state,
+action per step), ``metrics.json`` and the plots ``map.png`` and ``coverage.png``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from cogmap.agent.aimapp import AIMAPPAgent, Decision, Sensed
+from cogmap.agent.config import AgentConfig
+from cogmap.metrics import CoverageTracker, coverage_efficiency, nauc, rmse
+
+TRAJ_FIELDS = [
+    "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y",
+    "state", "action", "mode", "moved", "num_states", "num_obs", "coverage", "distance", "decision_ms",
+]
+
+
+def layout_name(env: str) -> str:
+    """Accept a layout name (``mini_warehouse``) or a registered id (``cogmap/MiniWarehouse-v0``)."""
+    from cogmap.envs.layouts import LAYOUTS
+    from cogmap.envs.registry import LAYOUT_IDS
+
+    if env in LAYOUT_IDS:
+        return LAYOUT_IDS[env]
+    if env in LAYOUTS:
+        return env
+    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)} or {sorted(LAYOUT_IDS)}")
+
+
+def default_config(env: str) -> AgentConfig:
+    """Influence radius 1 m in small rooms, 2 m in large ones (Table 6)."""
+    large = layout_name(env) in ("large_warehouse", "parking_lot", "aisle_warehouse", "house")
+    return AgentConfig(influence_radius=2.0 if large else 1.0)
+
+
+@dataclass
+class Episode:
+    """What a run produced (kept in memory; :func:`write_run` stores it)."""
+
+    rows: list[dict] = field(default_factory=list)
+    coverage: list[float] = field(default_factory=list)
+    distance: list[float] = field(default_factory=list)
+    decision_ms: list[float] = field(default_factory=list)
+    num_states: list[int] = field(default_factory=list)
+
+
+def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
+    from cogmap.envs import NavSim, OdometryNoise, SimConfig
+
+    sim_cfg = SimConfig(step_length=cfg.influence_radius, obstacle_margin=cfg.obstacle_margin,
+                        noise=noise or OdometryNoise())
+    return NavSim(layout_name(env), sim_cfg, seed=seed)
+
+
+def sense(sim, moved: bool | None) -> Sensed:
+    return Sensed(sim.panorama(), sim.obstacle_signal(), sim.odometry(), moved)
+
+
+def act(sim, agent: AIMAPPAgent, d: Decision) -> bool:
+    if d.action == agent.cfg.stay:
+        return bool(sim.stay().success)
+    return bool(sim.move_to(d.waypoint, frame="odom").success)
+
+
+def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episode: Episode | None = None,
+              on_step=None, stop=None) -> Episode:
+    """Drive ``agent`` in ``sim`` for ``steps`` decisions, tracking LiDAR coverage."""
+    from tqdm import tqdm
+
+    ep = episode or Episode()
+    if not hasattr(sim, "_coverage"):
+        free = sim.grid.reachable(sim.true_pose()[:2])
+        sim._coverage = CoverageTracker(free, sim.grid.origin, sim.grid.resolution)
+    tracker = sim._coverage
+    moved: bool | None = None
+    dist = ep.distance[-1] if ep.distance else 0.0
+    bar = tqdm(range(steps), disable=not progress, desc="explore", unit="step", leave=True)
+    for _ in bar:
+        tracker.update(sim.lidar_hits()[0])
+        sensed = sense(sim, moved)
+        t0 = time.perf_counter()
+        d = agent.step(sensed)
+        ms = 1e3 * (time.perf_counter() - t0)
+        true, odom = sim.true_pose(), sensed.odometry
+        belief = agent.believed_pose(odom) if odom is not None else np.full(2, np.nan)
+        ep.coverage.append(tracker.coverage)
+        ep.distance.append(dist)
+        ep.decision_ms.append(ms)
+        ep.num_states.append(agent.num_states)
+        odom = np.full(3, np.nan) if odom is None else odom
+        ep.rows.append(dict(
+            step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
+            odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], state=d.state, action=d.action,
+            mode=d.mode, moved=moved, num_states=agent.num_states,
+            num_obs=0 if agent.model is None else agent.model.num_obs[0], coverage=tracker.coverage,
+            distance=dist, decision_ms=ms,
+        ))
+        bar.set_postfix(cov=f"{tracker.coverage:.0%}", states=agent.num_states, mode=d.mode[:5])
+        if on_step is not None:
+            on_step(d)
+        before = sim.true_pose()[:2]
+        moved = act(sim, agent, d)
+        dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
+        if stop is not None and stop(d):
+            break
+    tracker.update(sim.lidar_hits()[0])
+    ep.coverage.append(tracker.coverage)
+    ep.distance.append(dist)
+    return ep
+
+
+def episode_metrics(sim, ep: Episode) -> dict:
+    rows = ep.rows
+    truth = np.array([[r["true_x"], r["true_y"]] for r in rows])
+    odom = np.array([[r["odom_x"], r["odom_y"]] for r in rows])
+    belief = np.array([[r["belief_x"], r["belief_y"]] for r in rows])
+    ok = np.all(np.isfinite(belief), axis=1) & np.all(np.isfinite(odom), axis=1)
+    dist = ep.distance[-1]
+    area = sim._coverage.area
+    return {
+        "steps": len(rows),
+        "coverage": ep.coverage[-1],
+        "area_covered_m2": area,
+        "free_area_m2": sim._coverage.total * sim.grid.resolution**2,
+        "distance_m": dist,
+        "coverage_efficiency": coverage_efficiency(area, dist),
+        "nauc": nauc(ep.distance, ep.coverage, budget=max(dist, 1e-9)),
+        "num_states": ep.num_states[-1] if ep.num_states else 0,
+        "num_observations": rows[-1]["num_obs"] if rows else 0,
+        "decision_ms_mean": float(np.mean(ep.decision_ms)) if ep.decision_ms else 0.0,
+        "decision_ms_p95": float(np.percentile(ep.decision_ms, 95)) if ep.decision_ms else 0.0,
+        "rmse_belief_m": rmse(belief[ok], truth[ok]) if ok.any() else None,
+        "rmse_odometry_m": rmse(odom[ok], truth[ok]) if ok.any() else None,
+        "failed_moves": int(sum(1 for r in rows if r["moved"] is False)),
+    }
+
+
+def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict) -> None:
+    from cogmap.genmodel.graph import write_graphml
+    from cogmap.genmodel.io import save
+
+    from . import plots
+
+    out.mkdir(parents=True, exist_ok=True)
+    save(agent.model, out / "model")
+    write_graphml(agent.model, out / "map.graphml")
+    obs_dir = out / "observations"
+    obs_dir.mkdir(exist_ok=True)
+    import cv2
+
+    for i, img in enumerate(getattr(agent.encoder, "images", [])):
+        cv2.imwrite(str(obs_dir / f"{i:04d}.png"), cv2.cvtColor(np.asarray(img), cv2.COLOR_RGB2BGR))
+    with open(out / "trajectory.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=TRAJ_FIELDS)
+        w.writeheader()
+        w.writerows(ep.rows)
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
+    plots.map_over_floorplan(out / "map.png", sim, agent, ep)
+    plots.coverage_curve(out / "coverage.png", ep)
+
+
+def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: Path | str | None = None,
+            config: AgentConfig | None = None, progress: bool = True, noise=None) -> dict:
+    """The main job: explore ``env`` for ``steps`` decisions and write the run directory."""
+    from .runs import write_manifest
+
+    cfg = config or default_config(env)
+    sim = make_sim(env, cfg, seed, noise)
+    try:
+        agent = AIMAPPAgent(cfg, seed=seed)
+        if out is not None:
+            out = Path(out)
+            write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed,
+                           config=cfg.to_dict(), noise=None if noise is None else noise.__dict__)
+        ep = run_agent(sim, agent, steps, progress)
+        metrics = episode_metrics(sim, ep)
+        if out is not None:
+            write_run(out, sim, agent, ep, metrics)
+        return metrics
+    finally:
+        sim.close()

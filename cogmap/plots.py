@@ -1,0 +1,60 @@
+"""PNG figures of a run: the cognitive map over the floor plan, and the coverage curve."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> Path:
+    """Floor plan, true path (grey), believed nodes coloured by observation, edges by belief."""
+    from cogmap.envs.render import draw_layout
+    from cogmap.genmodel.graph import to_graph
+
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(8, 8))
+    draw_layout(sim.layout, path=np.asarray(sim.path), ax=ax, show_starts=False)
+    if agent.model is not None:
+        g = to_graph(agent.model, min_prob=0.2)
+        poses = agent.poses
+        for a, b, data in g.edges(data=True):
+            ax.plot(*poses[[a, b]].T, color="tab:blue", lw=0.4 + 2.0 * data["prob"], alpha=0.6, zorder=4)
+        visited = agent.model.live_pA(0).max(axis=0) > 2 * agent.cfg.prior_count
+        obs = agent.model.live_A(0).argmax(axis=0)
+        ax.scatter(*poses[~visited].T, s=18, facecolors="white", edgecolors="tab:blue", zorder=5,
+                   label="predicted (unvisited) states")
+        ax.scatter(*poses[visited].T, s=34, c=obs[visited], cmap="tab20", edgecolors="k", lw=0.5, zorder=6,
+                   label="visited states (colour = observation)")
+        ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
+    cov = ep.coverage[-1] if ep.coverage else 0.0
+    ax.set_title(title or f"{sim.layout.name}: {agent.num_states} states, coverage {cov:.0%}, "
+                 f"{ep.distance[-1] if ep.distance else 0:.0f} m travelled")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
+
+
+def coverage_curve(path: Path, ep, label: str = "AIMAPP") -> Path:
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    ax.plot(ep.distance, np.asarray(ep.coverage) * 100, lw=2, label=label)
+    ax.set_xlabel("distance travelled (m)")
+    ax.set_ylabel("LiDAR coverage of free area (%)")
+    ax.set_ylim(0, 101)
+    ax.grid(alpha=0.3)
+    ax.legend(loc="lower right")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return Path(path)
