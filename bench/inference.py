@@ -21,7 +21,7 @@ import numpy as np
 
 from cogmap.compare import generate_sequence
 from cogmap.genmodel import Factor, Modality, ModelSpec, PoseSpec, SparseB, compile
-from cogmap.inference import filter as filter_scheme
+from cogmap.inference import bayes_filter as filter_scheme
 from cogmap.inference import fpi
 
 U, STAY, SLOTS = 13, 12, 8

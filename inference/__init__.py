@@ -1,8 +1,8 @@
 """State inference schemes behind one call, a registry, and a bridge to pymdp 1.0.
 
 Every scheme: ``posterior, info = scheme(model, prior, observations, actions=None, **options)``
-(conventions in :mod:`cogmap.inference.base`). Built-in names: ``exact``, ``filter``, ``fpi``,
-``vmp``, ``mmp``; ``get(name)``, ``register(name, fn)``, ``available()``.
+(conventions in :mod:`cogmap.inference.base`). Built-in names: ``exact``, ``filter``
+(:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``; ``get(name)``, ``register(name, fn)``, ``available()``.
 """
 
 from .base import (
@@ -14,14 +14,15 @@ from .base import (
     predict_factorised,
     prepare,
 )
+from .bayes_filter import bayes_filter
 from .exact import exact
-from .filter import filter  # noqa: A004 - scheme name
 from .fpi import fpi
 from .message_passing import mmp, vmp
 from .pymdp_bridge import to_pymdp
 from .registry import available, get, register, unregister
 
-for _name, _fn in (("exact", exact), ("filter", filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp)):
+_BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp))
+for _name, _fn in _BUILTIN:
     register(_name, _fn)
 
 __all__ = [
@@ -31,8 +32,8 @@ __all__ = [
     "InferenceInfo",
     "Problem",
     "available",
+    "bayes_filter",
     "exact",
-    "filter",
     "fpi",
     "get",
     "mmp",

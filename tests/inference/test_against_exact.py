@@ -73,7 +73,7 @@ def test_filter_soft_evidence_is_exact(seed):
     m = random_model(seed, sizes=(4,), modalities=((0,), (0,)))
     rng = np.random.default_rng(seed)
     obs = [[rng.dirichlet(np.ones(3)), None], [1, rng.dirichlet(np.ones(4))]]
-    q, info = inference.filter(m, priors(m), obs, [(1,)])
+    q, info = inference.bayes_filter(m, priors(m), obs, [(1,)])
     qe, infoe = inference.exact(m, priors(m), obs, [(1,)])
     np.testing.assert_allclose(q[0], qe[0], atol=TOL)
     assert info.free_energy == pytest.approx(infoe.free_energy, abs=1e-9)
@@ -93,7 +93,7 @@ def test_filter_with_pose_evidence_is_exact(seed, dense):
         [None, (100.0, 100.0)],  # far from every stored pose: no underflow
     ]
     act = [(0,), (4,), (12,)]
-    q, info = inference.filter(m, priors(m), obs, act)
+    q, info = inference.bayes_filter(m, priors(m), obs, act)
     qe, infoe = inference.exact(m, priors(m), obs, act, smooth=False)
     np.testing.assert_allclose(q[0], qe[0], atol=TOL)
     assert info.free_energy == pytest.approx(infoe.free_energy, abs=1e-8)
@@ -119,7 +119,7 @@ def test_growth_keeps_dead_states_out():
         assert q[0].shape == (n,)
         assert all(h[0].shape == (n,) for h in info.history)
     qe, _ = inference.exact(m, [D], obs, [(3,)])
-    qf, _ = inference.filter(m, [D], obs, [(3,)])
+    qf, _ = inference.bayes_filter(m, [D], obs, [(3,)])
     np.testing.assert_allclose(qf[0], qe[0], atol=TOL)
 
 

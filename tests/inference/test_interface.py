@@ -113,13 +113,13 @@ def test_prior_at_capacity_length_accepted():
     assert m.state_capacity(0) == 4
     full = np.zeros(4)
     full[:3] = m.live_D(0)
-    q, _ = inference.filter(m, [full], [[1]])
+    q, _ = inference.bayes_filter(m, [full], [[1]])
     assert q[0].shape == (3,)
     bad = full.copy()
     bad[3] = 0.1
     bad /= bad.sum()
     with pytest.raises(InferenceError, match="beyond the 3 live"):
-        inference.filter(m, [bad], [[1]])
+        inference.bayes_filter(m, [bad], [[1]])
 
 
 def test_exact_joint_size_guard():
@@ -131,7 +131,7 @@ def test_exact_joint_size_guard():
 def test_filter_refuses_multi_factor():
     m = random_model(2, sizes=(2, 2), modalities=((0,),))
     with pytest.raises(InferenceError, match="single-factor"):
-        inference.filter(m, [m.live_D(0), m.live_D(1)], [[0]])
+        inference.bayes_filter(m, [m.live_D(0), m.live_D(1)], [[0]])
 
 
 def test_zero_probability_observation_reported():

@@ -27,7 +27,7 @@ def _log_space_update(prior, evidence, t):
     return q / c, float(top + np.log(c))
 
 
-def filter(model, prior, observations, actions=None):  # noqa: A001 - registered scheme name
+def bayes_filter(model, prior, observations, actions=None):
     """Single-factor forward filter; ``info.free_energy`` is ``-log p(o_T | o_<T)``."""
     if len(model.factors) != 1:
         raise InferenceError(
