@@ -16,7 +16,7 @@ states the candidates can reach, so its cost is independent of the size of the m
 
 from __future__ import annotations
 
-from functools import cached_property, lru_cache
+from functools import lru_cache
 
 import numpy as np
 
@@ -24,6 +24,22 @@ from . import inductive as ind
 from .arrays import Prepared
 
 _LETTERS = "abcdefghijklmnopqrstuvwxyz"
+
+
+class cached_property:  # noqa: N801 - a lock-free variant of functools.cached_property
+    """Computed on first access, then stored on the instance (no lock: contexts are local)."""
+
+    def __init__(self, func):
+        self.func = func
+        self.name = func.__name__
+        self.__doc__ = func.__doc__
+
+    def __get__(self, obj, cls=None):
+        if obj is None:
+            return self
+        value = self.func(obj)
+        obj.__dict__[self.name] = value
+        return value
 
 
 @lru_cache(maxsize=64)
@@ -169,19 +185,34 @@ class LocalStep(_Common):
         prior_p = np.asarray(prior_p, dtype=float).reshape(-1)
         self.prior_idx, self.prior_p = prior_idx, prior_p
         K, R = acts.size, prior_idx.size
-        succ = B.succ[prior_idx[:, None], acts[None, :]]  # (R, K, k)
-        prob = B.prob[prior_idx[:, None], acts[None, :]] * prior_p[:, None, None]
-        self._succ, self._prob = succ, prob
-        U, inv = np.unique(succ, return_inverse=True)
-        inv = inv.reshape(succ.shape)
-        self.U = U
-        self._inv = inv
-        nU = U.size
-        flat = (np.arange(K)[None, :, None] * nU + inv).ravel()
-        qs = np.bincount(flat, weights=prob.ravel(), minlength=K * nU).reshape(K, nU)
+        if R == 1:
+            # point prior: the local space is the list of successor slots of each candidate
+            # (a state may appear more than once; every term is linear in qs, so that is exact)
+            s0 = prior_idx[0]
+            succ = B.succ[s0, acts]  # (K, k)
+            prob = B.prob[s0, acts] * prior_p[0]
+            k = succ.shape[1]
+            self.U = succ.ravel()
+            self._inv = np.arange(K * k).reshape(1, K, k)
+            qs = np.zeros((K, K * k))
+            qs.reshape(K * K * k)[(np.arange(K) * (K * k + k))[:, None] + np.arange(k)] = prob
+            self._point = True
+        else:
+            succ = B.succ[prior_idx[:, None], acts[None, :]]  # (R, K, k)
+            prob = B.prob[prior_idx[:, None], acts[None, :]] * prior_p[:, None, None]
+            U, inv = np.unique(succ, return_inverse=True)
+            self.U = U
+            self._inv = inv.reshape(succ.shape)
+            nU = U.size
+            flat = (np.arange(K)[None, :, None] * nU + self._inv).ravel()
+            qs = np.bincount(flat, weights=prob.ravel(), minlength=K * nU).reshape(K, nU)
+            self._point = False
         self.qs = [qs]
-        # the prior, as a (K, R) batch over its own support
-        self.qs_prev = [np.broadcast_to(prior_p, (K, R))]
+
+    @cached_property
+    def qs_prev(self) -> list:
+        """The prior as a (K, R) batch over its own support."""
+        return [np.broadcast_to(self.prior_p, (self.num_candidates, self.prior_idx.size))]
 
     @cached_property
     def _cols(self):
@@ -211,9 +242,17 @@ class LocalStep(_Common):
         from .efe import novelty_weights
 
         acts = self.actions[:, 0]
+        K = acts.size
+        if self._point:
+            counts = B.counts[self.prior_idx[0], acts]  # (K, k)
+            w = novelty_weights(counts, axis=1)
+            succ = self.U.reshape(K, -1)
+            q = self.qs[0].reshape(K * K, -1)[:: K + 1]  # each candidate's own slot block
+            # predicted probability of each slot's state (slots may repeat a state)
+            qn = ((succ[:, :, None] == succ[:, None, :]) * q[:, None, :]).sum(axis=2)
+            return [(qn * w).sum(axis=1) * self.prior_p[0]]
         counts = B.counts[self.prior_idx[:, None], acts[None, :]]  # (R, K, k)
         w = novelty_weights(counts, axis=2)
-        K = acts.size
         qn = self.qs[0][np.arange(K)[None, :, None], self._inv]  # predicted prob of each slot
         v = (self.prior_p[:, None, None] * qn * w).sum(axis=(0, 2))
         return [v]
@@ -240,5 +279,11 @@ class LocalStep(_Common):
         )
 
     def most_likely(self) -> np.ndarray:
-        """Most likely next state per candidate."""
+        """Most likely next state per candidate (summing repeated states of a point prior)."""
+        if self._point:
+            K = self.num_candidates
+            succ = self.U.reshape(K, -1)
+            q = self.qs[0].reshape(K * K, -1)[:: K + 1]
+            tot = ((succ[:, :, None] == succ[:, None, :]) * q[:, None, :]).sum(axis=2)
+            return succ[np.arange(K), tot.argmax(axis=1)]
         return self.U[self.qs[0].argmax(axis=1)]

@@ -5,9 +5,12 @@ are the ones allowed there (moves with possible transitions; at the root, not fl
 obstacle signal); their one-step EFE ``g`` is computed once, in a batch, when the node is
 expanded. Selection is UCB on the values: children not yet tried are tried first, best
 immediate EFE first; after that, the child maximising ``(Q_max - Q) / (Q_max - Q_min) +
-c sqrt(ln N / n)`` with ``Q`` the mean cumulative EFE backed up through it. The cumulative EFE
-of the path below each edge is backed up along the path. The decision is a softmax with
-precision ``gamma`` over the mean cumulative EFE of the root children (Eq. 4), taken by argmax
+c sqrt(ln N / n)`` with ``Q`` the cumulative EFE backed up through it. The cumulative EFE of
+the path below each edge is backed up along the path; an edge keeps the best (lowest) value
+seen below it (``backup="min"``: the rollouts are deterministic expected-EFE sequences, so this
+is the EFE of the best explored policy, as in exhaustive enumeration) or the mean
+(``backup="mean"``, classic UCT). The decision is a softmax with precision ``gamma`` over the
+root children's values (Eq. 4), taken by argmax
 or sampled with the given ``numpy.random.Generator``; the search is deterministic given it.
 
 Two expanders share this core:
@@ -45,11 +48,12 @@ class MCTSConfig:
     prune_obstacles: bool = True  # do not expand root moves flagged by the obstacle signal
     move_threshold: float = 0.0  # a move is allowed when P(leave the state) exceeds this
     share: str = "state_depth"  # key of visit statistics: "state_depth" or "state"
+    backup: str = "min"  # edge value: "min" (best cumulative EFE seen below it) or "mean"
     support_tol: float = 1e-9  # root belief entries below tol * max are dropped (local path)
 
 
 class Node:
-    __slots__ = ("actions", "g", "child", "n", "w", "N", "tie")
+    __slots__ = ("actions", "g", "child", "n", "w", "best", "N", "tie", "order", "tried")
 
     def __init__(self, actions, g, child, tie):
         self.actions = actions
@@ -57,8 +61,24 @@ class Node:
         self.child = child
         self.n = np.zeros(len(g))
         self.w = np.zeros(len(g))
+        self.best = np.full(len(g), np.inf)
         self.N = 0
         self.tie = tie
+        self.order = np.argsort(g + tie, kind="stable").tolist()  # untried: best g first
+        self.tried = 0
+
+    def select(self, c: float, use_min: bool = True) -> int:
+        """Same rule as :func:`ucb_select`, with the untried children taken in order."""
+        if self.tried < len(self.order):
+            i = self.order[self.tried]
+            self.tried += 1
+            return i
+        n = self.n
+        Q = self.best if use_min else self.w / n
+        lo, hi = Q.min(), Q.max()
+        span = hi - lo if hi > lo else 1.0
+        score = (hi - Q) / span + c * np.sqrt(math.log(max(self.N, 1)) / n) - self.tie
+        return int(score.argmax())
 
 
 def ucb_select(n: np.ndarray, w: np.ndarray, g: np.ndarray, N: int, c: float, tie=None) -> int:
@@ -81,7 +101,7 @@ class Decision:
     action: int | tuple  # control (or tuple of controls per factor) to execute
     actions: np.ndarray  # root candidate controls
     probs: np.ndarray  # decision distribution over root candidates
-    Q: np.ndarray  # mean cumulative EFE per root candidate (nan if never visited)
+    Q: np.ndarray  # backed-up cumulative EFE per root candidate (nan if never visited)
     visits: np.ndarray
     G_first: np.ndarray  # one-step EFE per root candidate
     info: dict = field(default_factory=dict)
@@ -194,11 +214,12 @@ def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> Decision:
     root = Node(acts, g, kids, rng.random(len(g)) * 1e-9)
     nodes: dict = {}
     by_state = cfg.share == "state"
+    use_min = cfg.backup == "min"
     for _ in range(cfg.simulations):
         node = root
         path = []
         for d in range(cfg.depth):
-            i = ucb_select(node.n, node.w, node.g, node.N, cfg.c, node.tie)
+            i = node.select(cfg.c, use_min)
             path.append((node, i))
             if d + 1 == cfg.depth:
                 break
@@ -215,10 +236,12 @@ def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> Decision:
             ret += node.g[i]
             node.n[i] += 1.0
             node.w[i] += ret
+            if ret < node.best[i]:
+                node.best[i] = ret
             node.N += 1
     visited = root.n > 0
     Q = np.full(len(root.g), np.nan)
-    Q[visited] = root.w[visited] / root.n[visited]
+    Q[visited] = (root.best if use_min else root.w / np.maximum(root.n, 1))[visited]
     probs = np.zeros(len(root.g))
     if visited.any():
         probs[visited] = softmax(-cfg.gamma * Q[visited])
