@@ -154,8 +154,18 @@ def learn_observation(model: Model, modality: int, obs: int, qs: list[np.ndarray
     m = model.modality_index(modality)
     if model.pA[m] is None:
         raise SpecError(f"learn_observation: modality '{model.modalities[m].name}' has no pA counts")
-    live = (slice(0, model.num_obs[m]),) + tuple(slice(0, model.num_states[f]) for f in model.A_deps[m])
-    deps_q = [np.asarray(qs[f])[: model.num_states[f]] for f in model.A_deps[m]]
+    deps = model.A_deps[m]
+    deps_q = [np.asarray(qs[f])[: model.num_states[f]] for f in deps]
+    n_o = model.num_obs[m]
+    if len(deps) == 1:  # touch only the columns the belief reaches: O(outcomes x support)
+        cols = np.flatnonzero(deps_q[0] > 0)
+        o = _as_distribution(obs, n_o)
+        block = model.pA[m][:n_o, cols] + lr * np.outer(o, deps_q[0][cols])
+        block = np.where(o[:, None] > 0, np.maximum(block, 1e-3), block)
+        model.pA[m][:n_o, cols] = block
+        model.A[m][:n_o, cols] = normalise_counts(block)
+        return
+    live = (slice(0, n_o),) + tuple(slice(0, model.num_states[f]) for f in deps)
     new = update_pA(model.pA[m][live], obs, deps_q, lr)
     model.pA[m][live] = new
     model.A[m][live] = normalise_counts(new)

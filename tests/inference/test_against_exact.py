@@ -6,7 +6,7 @@ mean-field schemes on models whose posterior factorises); bounds and MAP agreeme
 
 import numpy as np
 import pytest
-from helpers import (
+from inference_helpers import (
     brute_force_log_evidence,
     brute_force_marginals,
     dirichlet,

@@ -1,7 +1,7 @@
 """The comparison harness."""
 
 import numpy as np
-from helpers import pose_model, random_model
+from inference_helpers import pose_model, random_model
 
 from cogmap.compare import Row, compare_inference, format_table, generate_sequence
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from helpers import random_model
+from inference_helpers import random_model
 
 from cogmap import inference
 from cogmap.inference import InferenceError, InferenceInfo

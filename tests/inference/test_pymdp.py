@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from helpers import random_model, random_sequence
+from inference_helpers import random_model, random_sequence
 
 pytest.importorskip("pymdp")
 import jax  # noqa: E402
@@ -81,7 +81,7 @@ def test_to_pymdp_agent_infer_states(sizes, mods):
 
 
 def test_to_pymdp_sparse_and_counts():
-    from helpers import pose_model
+    from inference_helpers import pose_model
 
     m = pose_model(10, 0)
     m.pA[0] = np.where(m.A[0] > 0, 1.0, 0.0) + m.A[0]
