@@ -39,8 +39,8 @@ def layout_name(env: str) -> str:
 
 
 def default_config(env: str) -> AgentConfig:
-    """Influence radius 1 m in small rooms, 2 m in large ones (Table 6)."""
-    large = layout_name(env) in ("large_warehouse", "parking_lot", "aisle_warehouse", "house")
+    """Influence radius 1 m in small rooms and the house (doorways), 2 m in large open ones (Table 6)."""
+    large = layout_name(env) in ("large_warehouse", "parking_lot", "aisle_warehouse")
     return AgentConfig(influence_radius=2.0 if large else 1.0)
 
 
@@ -63,8 +63,16 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
     return NavSim(layout_name(env), sim_cfg, seed=seed)
 
 
-def sense(sim, moved: bool | None) -> Sensed:
-    return Sensed(sim.panorama(), sim.obstacle_signal(), sim.odometry(), moved)
+def sense(sim, moved: bool | None, cfg: AgentConfig) -> Sensed:
+    """Panorama, odometry and the corridor obstacle signal (odometry frame) from the robot."""
+    from cogmap.agent.sensing import corridor_obstacles
+
+    ranges, odom = sim.lidar(), sim.odometry()
+    obstacles = None
+    if ranges is not None and odom is not None:
+        obstacles = corridor_obstacles(ranges, sim.lidar_angles() + odom[2], cfg.num_headings, cfg.influence_radius,
+                                       cfg.robot_radius + cfg.obstacle_margin, sim.config.lidar_range)
+    return Sensed(sim.panorama(), obstacles, odom, moved)
 
 
 def act(sim, agent: AIMAPPAgent, d: Decision) -> bool:
@@ -88,7 +96,7 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
     bar = tqdm(range(steps), disable=not progress, desc="explore", unit="step", leave=True)
     for _ in bar:
         tracker.update(sim.lidar_hits()[0])
-        sensed = sense(sim, moved)
+        sensed = sense(sim, moved, agent.cfg)
         t0 = time.perf_counter()
         d = agent.step(sensed)
         ms = 1e3 * (time.perf_counter() - t0)

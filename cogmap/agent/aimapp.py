@@ -24,14 +24,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cogmap.genmodel import Factor, Modality, Model, ModelSpec, PoseSpec, SparseB, compile
-from cogmap.inference import filter as bayes_filter
+from cogmap.inference import bayes_filter
 from cogmap.inference.learning import Event, learn_observation, learn_transition
 
 from . import planner
 from .confidence import Confidence, assess
 from .config import AgentConfig
 from .encoder import Encoder, SSIMEncoder
-from .mapping import direction, expansion_free_energy, reverse_heading
+from .mapping import direction, expansion_free_energies, reverse_heading
 
 
 @dataclass
@@ -95,6 +95,7 @@ class AIMAPPAgent:
         self.lost = False  # the confidence test fired: re-localising
         self.lost_evidence = 0.0  # CUSUM statistic of conflict
         self.lost_events = 0
+        self.last_obs: int | None = None
         self.relocalisations = 0
 
     # -- public ------------------------------------------------------------------------------
@@ -108,6 +109,23 @@ class AIMAPPAgent:
 
     def believed_pose(self, odometry) -> np.ndarray:
         return np.asarray(odometry, dtype=float)[:2] + self.offset
+
+    @property
+    def at_goal(self) -> bool:
+        """The last step confidently observed the goal observation."""
+        last = self.last
+        return (self.goal_obs is not None and self.last_obs == self.goal_obs and last is not None
+                and last.confidence is not None and last.confidence.confident)
+
+    def localise_at(self, odometry) -> int:
+        """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``."""
+        d = np.hypot(*(self.poses - self.believed_pose(odometry)).T)
+        s = int(np.argmin(d))
+        self.q = np.zeros(self.num_states)
+        self.q[s] = 1.0
+        self.offset += self.poses[s] - self.believed_pose(odometry)
+        self.last, self._outcome = None, None
+        return s
 
     def set_goal(self, obs: int | None) -> None:
         """Prefer observation ``obs`` (goal mode), or return to exploration with ``None``."""
@@ -136,6 +154,7 @@ class AIMAPPAgent:
             self.model = initial_model(cfg, pose)
             self.q = np.ones(1)
         obs, _ = self.encoder(sensed.panorama)
+        self.last_obs = obs
         score = float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
         while self.model.num_obs[0] <= obs:
             self.model.add_observation(0)
@@ -227,26 +246,34 @@ class AIMAPPAgent:
     def _expand(self, state: int, obstacles: np.ndarray) -> int:
         """Predicted transitions from the obstacle signal and Eq. (7) map expansion."""
         m, cfg = self.model, self.cfg
-        created = 0
+        radius = cfg.node_spacing * cfg.influence_radius
         origin = self.poses[state].copy()
-        for h in range(cfg.num_headings):
-            p_star = origin + cfg.influence_radius * direction(h, cfg.num_headings)
-            exp = expansion_free_energy(p_star, self.poses, cfg.node_spacing * cfg.influence_radius, cfg.sigma)
-            rev = reverse_heading(h, cfg.num_headings)
+        headings = np.arange(cfg.num_headings)
+        cands = origin + cfg.influence_radius * np.stack([direction(h, cfg.num_headings) for h in headings])
+        dist = np.hypot(*(self.poses[None, :, :] - cands[:, None, :]).transpose(2, 0, 1))  # (headings, states)
+        nearest = dist.argmin(axis=1)
+        created: list[tuple[int, np.ndarray]] = []
+        for h in headings:
+            near, d = int(nearest[h]), float(dist[h, nearest[h]])
+            for s_new, p_new in created:  # states created by this call also exert influence
+                dn = float(np.hypot(*(p_new - cands[h])))
+                if dn < d:
+                    near, d = s_new, dn
+            expand = expansion_free_energies(np.array([d]), radius, cfg.sigma)[0] < 0  # Eq. (7)
+            rev = reverse_heading(int(h), cfg.num_headings)
             if obstacles[h]:
-                if exp.nearest >= 0 and exp.nearest != state and exp.distance < cfg.influence_radius:
-                    learn_transition(m, 0, state, h, exp.nearest, Event.PREDICTED_IMPOSSIBLE,
-                                     reverse_control=rev, rates=cfg.learning)
-                continue
-            if exp.expand and created < cfg.lookahead_nodes:
-                new = m.add_state(0, pose=p_star)
-                created += 1
-                learn_transition(m, 0, state, h, new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
+                if near != state and d < cfg.influence_radius:
+                    learn_transition(m, 0, state, int(h), near, Event.PREDICTED_IMPOSSIBLE, reverse_control=rev,
+                                     rates=cfg.learning)
+            elif expand and len(created) < cfg.lookahead_nodes:
+                new = m.add_state(0, pose=cands[h])
+                created.append((new, cands[h]))
+                learn_transition(m, 0, state, int(h), new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
                                  rates=cfg.learning)
-            elif not exp.expand and exp.nearest != state:
-                learn_transition(m, 0, state, h, exp.nearest, Event.PREDICTED_POSSIBLE, reverse_control=rev,
+            elif not expand and near != state:
+                learn_transition(m, 0, state, int(h), near, Event.PREDICTED_POSSIBLE, reverse_control=rev,
                                  rates=cfg.learning)
-        return created
+        return len(created)
 
     def _waypoint(self, state: int, action: int) -> tuple[int, np.ndarray]:
         """Where an action leads: the believed successor node, or one step in its heading."""

@@ -17,7 +17,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from cogmap.inference.reduction import reduce_dirichlet
+from cogmap.inference.reduction import log_beta
 
 CONCENTRATION = 4.0  # prior counts of the believed pose outcome in either model
 BASE = 0.25  # prior counts of the other outcome
@@ -40,13 +40,22 @@ def expansion_free_energy(pred_pose, poses: np.ndarray, influence_radius: float,
         return Expansion(-np.inf, -1, np.inf)
     d = np.hypot(*(poses - np.asarray(pred_pose, dtype=float)).T)
     k = int(np.argmin(d))
-    w_near = np.exp(-(d[k] ** 2) / (2 * sigma**2))
+    return Expansion(float(expansion_free_energies(d[k : k + 1], influence_radius, sigma)[0]), k, float(d[k]))
+
+
+def expansion_free_energies(nearest_distance: np.ndarray, influence_radius: float, sigma: float) -> np.ndarray:
+    """Vectorised Eq. (7): free-energy change of expanding, for candidates whose nearest stored
+    pose is ``nearest_distance`` away (one BMR per candidate, columns of a 2-outcome Dirichlet)."""
+    d = np.asarray(nearest_distance, dtype=float)
+    w_near = np.exp(-(d**2) / (2 * sigma**2))
     w_new = np.exp(-(influence_radius**2) / (2 * sigma**2))
-    counts = np.array([w_near, w_new]) / (w_near + w_new)
-    current = np.array([CONCENTRATION, BASE])
-    expanded = np.array([BASE, CONCENTRATION])
-    F = reduce_dirichlet(current + counts, current, expanded).free_energy
-    return Expansion(float(F), k, float(d[k]))
+    counts = np.stack([w_near, np.full_like(w_near, w_new)]) / (w_near + w_new)
+    current = np.array([[CONCENTRATION], [BASE]])
+    expanded = np.array([[BASE], [CONCENTRATION]])
+    q = current + counts
+    s = q + expanded - current
+    return log_beta(q) + log_beta(np.broadcast_to(expanded, q.shape)) - log_beta(
+        np.broadcast_to(current, q.shape)) - log_beta(s)
 
 
 def direction(heading_index: int, num_headings: int) -> np.ndarray:

@@ -22,7 +22,9 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     """Return (control, summary) for the agent's current belief ``agent.q``."""
     cfg, model = agent.cfg, agent.model
     n = model.num_states[0]
-    obstacles = np.append(np.asarray(obstacles, dtype=bool), False)  # the stay control never collides
+    # The stay control never collides, but standing still gains nothing while exploring or
+    # re-localising (MCTS would value it like the best move after it): it is offered in goal mode only.
+    obstacles = np.append(np.asarray(obstacles, dtype=bool), mode != "goal")
     mcfg = MCTSConfig(depth=cfg.mcts_depth, simulations=cfg.mcts_simulations, gamma=cfg.gamma)
     C_states, C_obs = model.C_states[0], model.C[0]
     C_states[:n] = 0.0

@@ -6,7 +6,8 @@ from scipy.ndimage import gaussian_filter
 
 from cogmap.agent.confidence import assess, conflict, dominance
 from cogmap.agent.encoder import SSIMEncoder, ssim
-from cogmap.agent.mapping import expansion_free_energy
+from cogmap.agent.mapping import expansion_free_energies, expansion_free_energy
+from cogmap.inference.reduction import reduce_dirichlet
 
 
 def reference_ssim(a, b):
@@ -59,6 +60,14 @@ def test_expansion_follows_the_free_energy_sign():
     assert not expansion_free_energy([1.99, 0.0], poses, R, sigma).expand
     assert expansion_free_energy([2.01, 0.0], poses, R, sigma).expand
     assert expansion_free_energy([5.0, 5.0], np.zeros((0, 2)), R, sigma).expand
+    # the vectorised form is one Bayesian model reduction (Eq. 7) per candidate
+    d = np.array([0.3, 0.99, 1.01, 2.5])
+    single = []
+    for x in d:
+        w = np.array([np.exp(-(x**2) / (2 * sigma**2)), np.exp(-(R**2) / (2 * sigma**2))])
+        current, expanded = np.array([4.0, 0.25]), np.array([0.25, 4.0])
+        single.append(reduce_dirichlet(current + w / w.sum(), current, expanded).free_energy)
+    np.testing.assert_allclose(expansion_free_energies(d, R, sigma), single)
 
 
 def test_confidence_scores_do_not_depend_on_map_size():
@@ -72,5 +81,12 @@ def test_confidence_scores_do_not_depend_on_map_size():
     # a familiar observation strongly tied to state 1 seen while believing state 0: conflict
     A_row = np.array([0.01, 0.95])
     assert conflict(A_row, np.array([0.999, 0.001])) > 4
-    assert not assess(np.array([0.999, 0.001]), np.array([0.999, 0.001]), A_row, 4.0).confident
     assert conflict(A_row, np.array([0.001, 0.999])) < 0.1
+    # the lost test is a CUSUM on conflict: one odd view does not fire it, a run of them does
+    believed = np.array([0.999, 0.001])
+    first = assess(believed, believed, A_row, 4.0, evidence=0.0, slack=1.0)
+    assert first.confident and not first.lost(4.0)
+    second = assess(believed, believed, A_row, 4.0, evidence=first.lost_evidence, slack=1.0)
+    assert second.lost(4.0) and not second.confident
+    calm = assess(believed, believed, np.array([0.9, 0.3]), 4.0, evidence=3.0, slack=1.0)
+    assert calm.lost_evidence < 3.0  # expected observations drain the statistic

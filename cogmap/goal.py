@@ -1,0 +1,102 @@
+"""Goal reaching with a model learnt during exploration (section 4.4).
+
+The goal is an image (or a stored observation id). It is recognised by the encoder, and the
+agent plans in goal mode: preference weight 10 on the goal observation, the inductive term
+toward the states that produced it, and the collision term. The run stops when the agent
+confidently observes the goal.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+
+from cogmap.agent.aimapp import AIMAPPAgent
+from cogmap.agent.config import AgentConfig
+from cogmap.agent.encoder import SSIMEncoder
+
+from .explore import episode_metrics, make_sim, run_agent, write_run
+
+
+def astar_length(grid, start_xy, goal_xy, robot_radius: float) -> float:
+    """Shortest collision-free path length (m) for a disc robot on the occupancy grid."""
+    from cogmap.planning.astar import astar_grid
+
+    blocked = grid.inflated(robot_radius * 0.9)
+    s, g = grid.world_to_cell(np.asarray(start_xy)[:2]), grid.world_to_cell(np.asarray(goal_xy)[:2])
+    _, length = astar_grid(blocked, tuple(s), tuple(g), grid.resolution)
+    return float(length)
+
+
+def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
+    """Rebuild an agent (model, observations, config) from a run directory."""
+    import cv2
+
+    from cogmap.genmodel.io import load
+
+    run = Path(run)
+    manifest = json.loads((run / "run.json").read_text())
+    cfg = AgentConfig.from_dict(manifest["config"])
+    encoder = SSIMEncoder(cfg.ssim_threshold)
+    for png in sorted((run / "observations").glob("*.png")):
+        encoder.add(cv2.cvtColor(cv2.imread(str(png)), cv2.COLOR_BGR2RGB))
+    model = load(run / "model")
+    if len(encoder) != model.num_obs[0]:
+        raise ValueError(f"{run}: {len(encoder)} observation images for {model.num_obs[0]} model outcomes")
+    return AIMAPPAgent(cfg, encoder=encoder, seed=seed, model=model), manifest
+
+
+def goal_observation(agent: AIMAPPAgent, image: np.ndarray) -> int:
+    """Id of the stored observation matching ``image``; a clear error when none matches."""
+    best, score = agent.encoder.match(image)
+    if best < 0 or score < agent.cfg.ssim_threshold:
+        raise ValueError(f"goal image not recognised (best SSIM {score:.2f} < {agent.cfg.ssim_threshold})")
+    return best
+
+
+def pursue(sim, agent: AIMAPPAgent, goal_obs: int, steps: int, progress: bool = True):
+    """Run goal mode from the robot's current place until the goal is observed; returns the
+    episode and summary (reached, path length, A* length, ratio)."""
+    agent.set_goal(goal_obs)
+    start = sim.true_pose()[:2].copy()
+    ep = run_agent(sim, agent, steps, progress, stop=lambda d: agent.at_goal)
+    end = sim.true_pose()[:2]
+    executed = ep.distance[-1]
+    optimal = astar_length(sim.grid, start, end, sim.config.robot_radius)
+    summary = {
+        "reached": bool(agent.at_goal),
+        "steps": len(ep.rows),
+        "executed_m": executed,
+        "astar_m": optimal,
+        "path_ratio": executed / optimal if optimal > 0 and np.isfinite(optimal) else None,
+        "goal_obs": int(goal_obs),
+    }
+    return ep, summary
+
+
+def reach_goal(run: Path, goal_image: str | None = None, goal_obs: int | None = None, steps: int = 60,
+               seed: int = 0, out: Path | None = None, progress: bool = True) -> dict:
+    """``cogmap goal``: start where the exploration started, knowing it (section 4.1 protocol)."""
+    import cv2
+
+    from .runs import write_manifest
+
+    agent, manifest = load_agent(run, seed)
+    if goal_image is not None:
+        img = cv2.imread(str(goal_image))
+        if img is None:
+            raise ValueError(f"cannot read goal image {goal_image}")
+        goal_obs = goal_observation(agent, cv2.cvtColor(img, cv2.COLOR_BGR2RGB))
+    sim = make_sim(manifest["env"], agent.cfg, manifest["seed"])
+    try:
+        agent.localise_at(sim.odometry())
+        out = Path(out) if out is not None else Path(run) / "goal"
+        write_manifest(out, command="goal", run=str(run), goal_obs=goal_obs, steps=steps, seed=seed)
+        ep, summary = pursue(sim, agent, goal_obs, steps, progress)
+        metrics = {**episode_metrics(sim, ep), **summary}
+        write_run(out, sim, agent, ep, metrics)
+        return metrics
+    finally:
+        sim.close()
