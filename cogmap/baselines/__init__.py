@@ -1,0 +1,1 @@
+"""Exploration baselines: frontier, random walk, oracle coverage."""
