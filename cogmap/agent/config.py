@@ -25,7 +25,7 @@ class AgentConfig:
     inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
     collision_preference: float = -6.0  # log-preference of a collision outcome
     prior_count: float = 0.1  # Dirichlet count of each outcome in a new column
-    obs_learning_rate: float = 1.0  # counts added when an observation is tied to a state (Table 6)
+    obs_learning_rate: float = 4.0  # counts added when an observation is tied to a state
     relocalise_ssim: float = 0.9  # a recognised view this similar re-localises the metric pose
     lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)
     learning: LearningRates = field(default_factory=LearningRates)
