@@ -103,3 +103,70 @@ def grid_image(grid, robot_xy=None, path=None) -> np.ndarray:
         r, c = grid.world_to_cell(robot_xy[:2])
         img[max(r - 3, 0):r + 4, max(c - 3, 0):c + 4] = (220, 0, 0)
     return np.ascontiguousarray(img[::-1])
+
+
+def demo_walk(layout: Layout, n_steps: int = 60, seed: int = 0, spacing: float = 1.0):
+    """A seeded random walk (no pybullet) and a pose graph over it, for illustrations.
+
+    A node is added whenever the robot is more than `spacing` from every node; consecutive
+    nearest nodes are joined by an edge.
+    """
+    import networkx as nx
+
+    from .geometry import ShapeSet
+    from .robot import ROBOT_RADIUS, straight_move
+
+    rng = np.random.default_rng(seed)
+    shapes = ShapeSet(layout.shapes)
+    xy = np.array(layout.starts[0][:2], float)
+    path, graph = [xy.copy()], nx.Graph()
+    graph.add_node(0, pos=tuple(xy))
+    nodes, last, heading = [xy.copy()], 0, 0
+    for _ in range(n_steps):
+        if rng.random() < 0.3:
+            heading = (heading + int(rng.integers(-2, 3))) % 12
+        a = 2 * np.pi * heading / 12
+        end, dist, ok, _ = straight_move(shapes, ROBOT_RADIUS, xy,
+                                         xy + np.array([np.cos(a), np.sin(a)]))
+        if not ok:
+            heading = (heading + 6) % 12
+        if dist <= 0:
+            continue
+        xy = end
+        path.append(xy.copy())
+        d = np.hypot(*(np.array(nodes) - xy).T)
+        if d.min() > spacing:
+            graph.add_node(len(nodes), pos=tuple(xy))
+            nodes.append(xy.copy())
+            cur = len(nodes) - 1
+        else:
+            cur = int(np.argmin(d))
+        if cur != last:
+            graph.add_edge(last, cur)
+        last = cur
+    return np.array(path), graph
+
+
+def main(argv=None) -> None:
+    """Write one PNG per layout: `python -m cogmap.envs.render OUTDIR`."""
+    import sys
+    from pathlib import Path
+
+    from .layouts import LAYOUTS, make_layout
+    from .occupancy import layout_grid
+
+    out = Path((argv or sys.argv[1:] or ["docs/img/envs"])[0])
+    out.mkdir(parents=True, exist_ok=True)
+    for name in LAYOUTS:
+        lay = make_layout(name, 0)
+        grid = layout_grid(lay)
+        path, graph = demo_walk(lay, 80)
+        area = grid.free_area(lay.starts[0][:2])
+        paper = f", paper {lay.paper_area:g} m2" if lay.paper_area else ""
+        save_layout_png(lay, out / f"{name}.png", path=path, graph=graph, grid=grid,
+                        title=f"{name}: free area {area:.1f} m2{paper}")
+        print(out / f"{name}.png")
+
+
+if __name__ == "__main__":
+    main()

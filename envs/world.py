@@ -81,7 +81,7 @@ class PyBulletScene:
         ox, oy = float(origin_xy[0]), float(origin_xy[1])
         frm = np.stack([ox + r_min * c, oy + r_min * s, np.full_like(c, z)], 1)
         to = np.stack([ox + r_max * c, oy + r_max * s, np.full_like(c, z)], 1)
-        out = p.rayTestBatch(frm.tolist(), to.tolist(), physicsClientId=self.client)
+        out = p.rayTestBatch(frm, to, physicsClientId=self.client)
         ids = np.array([o[0] for o in out])
         frac = np.array([o[2] for o in out])
         hit = (ids >= 0) & (ids != self.robot)
