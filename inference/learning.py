@@ -6,7 +6,10 @@ transitions), keeping counts positive and columns normalised.
 
 Transition learning rates depend on the event (Table 7 of the AIMAPP paper): an experienced
 move counts more than a predicted one, and the reverse move is reinforced less than the
-forward one.
+forward one. A negative rate removes counts from the move's target (floored so counts stay
+positive) and adds them to staying in place, which is what a blocked move is evidence of; a
+column's total concentration is capped so that beliefs reinforced many times can still change
+when the world does (a moved obstacle).
 """
 
 from __future__ import annotations
@@ -37,6 +40,7 @@ class LearningRates:
     forward: tuple[float, float, float, float] = (7.0, -7.0, 5.0, -5.0)
     reverse: tuple[float, float, float, float] = (5.0, -5.0, 3.0, -3.0)
     floor: float = 1e-3  # counts never fall below this (they must stay positive)
+    max_concentration: float = 10.0  # a column's counts are scaled down past this (forgetting)
 
     def rate(self, event: Event, reverse: bool = False) -> float:
         order = (Event.POSSIBLE, Event.IMPOSSIBLE, Event.PREDICTED_POSSIBLE, Event.PREDICTED_IMPOSSIBLE)
@@ -124,29 +128,40 @@ def learn_transition(
             continue
         B = model.B[f]
         if isinstance(B, SparseTransitions):
-            _learn_sparse(B, a, u, b, lr, rates.floor)
+            _learn_sparse(B, a, u, b, lr, rates)
         else:
-            _learn_dense(model, f, a, u, b, lr, rates.floor)
+            _learn_dense(model, f, a, u, b, lr, rates)
 
 
-def _learn_sparse(B: SparseTransitions, s: int, u: int, target: int, lr: float, floor: float) -> None:
+def _learn_sparse(B: SparseTransitions, s: int, u: int, target: int, lr: float, rates: LearningRates) -> None:
     if B.counts is None:
         raise SpecError("learn_transition: transitions have no Dirichlet counts")
     if lr < 0 and B.slot_of(s, u, target, create=False) < 0:
         return  # nothing believed to remove
     k = B.slot_of(s, u, target)
-    B.counts[s, u, k] = max(B.counts[s, u, k] + lr, floor)
+    B.counts[s, u, k] = max(B.counts[s, u, k] + lr, rates.floor)
+    if lr < 0:
+        B.counts[s, u, B.slot_of(s, u, s)] += -lr
+    total = B.counts[s, u].sum()
+    if total > rates.max_concentration:
+        B.counts[s, u] *= rates.max_concentration / total
     B.renormalise_column(s, u)
 
 
-def _learn_dense(model: Model, f: int, s: int, u: int, target: int, lr: float, floor: float) -> None:
+def _learn_dense(model: Model, f: int, s: int, u: int, target: int, lr: float, rates: LearningRates) -> None:
     pB = model.pB[f]
     if pB is None:
         raise SpecError(f"learn_transition: factor '{model.factors[f].name}' has no pB counts")
     n = model.num_states[f]
-    pB[target, s, u] = max(pB[target, s, u] + lr, floor)
+    pB[target, s, u] = max(pB[target, s, u] + lr, rates.floor)
+    if lr < 0:
+        pB[s, s, u] += -lr
     col = pB[:n, s, u]
-    model.B[f][:n, s, u] = col / col.sum()
+    total = col.sum()
+    if total > rates.max_concentration:
+        col *= rates.max_concentration / total
+        total = rates.max_concentration
+    model.B[f][:n, s, u] = col / total
 
 
 def learn_observation(model: Model, modality: int, obs: int, qs: list[np.ndarray], lr: float = 1.0) -> None:

@@ -158,7 +158,7 @@ class AIMAPPAgent:
         score = float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
         while self.model.num_obs[0] <= obs:
             self.model.add_observation(0)
-        prior = self._prior(self._outcome)
+        prior = self._visited_prior() if self.lost else self._prior(self._outcome)
         if self.lost:
             # Re-localisation: odometry is not trusted, only what is seen (section 3.3).
             q, _ = bayes_filter(self.model, [prior], [{"view": obs}])
@@ -169,7 +169,7 @@ class AIMAPPAgent:
         state = int(np.argmax(q))
         expanded = 0
         if self.lost:
-            if conf.dominance >= cfg.z_threshold and self._recognised(state, obs):
+            if q[state] >= 0.5 and self._recognised(state, obs):  # a familiar view singles out a place
                 self.lost, self.lost_evidence = False, 0.0
                 self.offset += self.poses[state] - pose  # found again: trust the map's pose
                 self.relocalisations += 1
@@ -187,11 +187,18 @@ class AIMAPPAgent:
         self.q[: q.size] = q
         state = int(np.argmax(self.q))
         if self.lost:
+            # The map position is unknown, so the graph cannot guide a move: step in a free
+            # direction of the real surroundings until a familiar view is recognised.
             mode = "relocalise"
+            free = np.flatnonzero(~np.asarray(sensed.obstacles, dtype=bool))
+            action = int(self.rng.choice(free)) if free.size else cfg.stay
+            efe = {}
+            target = state
+            waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
         else:
             mode = "goal" if self.goal_obs is not None else "explore"
-        action, efe = planner.decide(self, state, sensed.obstacles, mode)
-        target, waypoint = self._waypoint(state, action)
+            action, efe = planner.decide(self, state, sensed.obstacles, mode)
+            target, waypoint = self._waypoint(state, action)
         decision = Decision(action, waypoint - self.offset, state, target, mode, conf, expanded, efe)
         self.last = decision
         self._outcome = None
@@ -243,37 +250,47 @@ class AIMAPPAgent:
             return 0
         return self._expand(state, np.asarray(sensed.obstacles, dtype=bool))
 
+    def _neighbours_by_heading(self, state: int) -> np.ndarray:
+        """For each heading, the nearest state lying in that direction (bearing within half a
+        heading sector, at most 1.5 influence radii away), or -1."""
+        cfg = self.cfg
+        rel = self.poses - self.poses[state]
+        dist = np.hypot(*rel.T)
+        bearing = np.arctan2(rel[:, 1], rel[:, 0])
+        sector = np.pi / cfg.num_headings
+        out = np.full(cfg.num_headings, -1)
+        for h in range(cfg.num_headings):
+            off = np.abs((bearing - 2 * np.pi * h / cfg.num_headings + np.pi) % (2 * np.pi) - np.pi)
+            ok = (off <= sector + 1e-9) & (dist > 1e-9) & (dist <= 1.5 * cfg.influence_radius)
+            if ok.any():
+                out[h] = int(np.flatnonzero(ok)[np.argmin(dist[ok])])
+        return out
+
     def _expand(self, state: int, obstacles: np.ndarray) -> int:
-        """Predicted transitions from the obstacle signal and Eq. (7) map expansion."""
+        """Predicted transitions from the obstacle signal, and Eq. (7) map expansion in free
+        directions where no state lies yet."""
         m, cfg = self.model, self.cfg
         radius = cfg.node_spacing * cfg.influence_radius
         origin = self.poses[state].copy()
-        headings = np.arange(cfg.num_headings)
-        cands = origin + cfg.influence_radius * np.stack([direction(h, cfg.num_headings) for h in headings])
-        dist = np.hypot(*(self.poses[None, :, :] - cands[:, None, :]).transpose(2, 0, 1))  # (headings, states)
-        nearest = dist.argmin(axis=1)
-        created: list[tuple[int, np.ndarray]] = []
-        for h in headings:
-            near, d = int(nearest[h]), float(dist[h, nearest[h]])
-            for s_new, p_new in created:  # states created by this call also exert influence
-                dn = float(np.hypot(*(p_new - cands[h])))
-                if dn < d:
-                    near, d = s_new, dn
-            expand = expansion_free_energies(np.array([d]), radius, cfg.sigma)[0] < 0  # Eq. (7)
-            rev = reverse_heading(int(h), cfg.num_headings)
-            if obstacles[h]:
-                if near != state and d < cfg.influence_radius:
-                    learn_transition(m, 0, state, int(h), near, Event.PREDICTED_IMPOSSIBLE, reverse_control=rev,
-                                     rates=cfg.learning)
-            elif expand and len(created) < cfg.lookahead_nodes:
-                new = m.add_state(0, pose=cands[h])
-                created.append((new, cands[h]))
-                learn_transition(m, 0, state, int(h), new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
+        neighbours = self._neighbours_by_heading(state)
+        created = 0
+        for h in range(cfg.num_headings):
+            rev = reverse_heading(h, cfg.num_headings)
+            n = int(neighbours[h])
+            if n >= 0:
+                event = Event.PREDICTED_IMPOSSIBLE if obstacles[h] else Event.PREDICTED_POSSIBLE
+                learn_transition(m, 0, state, h, n, event, reverse_control=rev, rates=cfg.learning)
+                continue
+            if obstacles[h] or created >= cfg.lookahead_nodes:
+                continue
+            p_star = origin + cfg.influence_radius * direction(h, cfg.num_headings)
+            d_near = float(np.min(np.hypot(*(self.poses - p_star).T)))
+            if expansion_free_energies(np.array([d_near]), radius, cfg.sigma)[0] < 0:  # Eq. (7)
+                new = m.add_state(0, pose=p_star)
+                created += 1
+                learn_transition(m, 0, state, h, new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
                                  rates=cfg.learning)
-            elif not expand and near != state:
-                learn_transition(m, 0, state, int(h), near, Event.PREDICTED_POSSIBLE, reverse_control=rev,
-                                 rates=cfg.learning)
-        return len(created)
+        return created
 
     def _waypoint(self, state: int, action: int) -> tuple[int, np.ndarray]:
         """Where an action leads: the believed successor node, or one step in its heading."""

@@ -22,6 +22,7 @@ class AgentConfig:
     gamma: float = 8.0  # policy precision (Eq. 4)
     pose_sigma: float | None = None  # width of the pose likelihood; default influence_radius / 3
     obstacle_margin: float = 0.1  # a direction is blocked when the sector's range < step + margin
+    min_move_probability: float = 0.1  # a move is planned only if it is believed to leave the state
     inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
     collision_preference: float = -6.0  # log-preference of a collision outcome
     prior_count: float = 0.1  # Dirichlet count of each outcome in a new column

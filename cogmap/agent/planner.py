@@ -25,7 +25,8 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     # The stay control never collides, but standing still gains nothing while exploring or
     # re-localising (MCTS would value it like the best move after it): it is offered in goal mode only.
     obstacles = np.append(np.asarray(obstacles, dtype=bool), mode != "goal")
-    mcfg = MCTSConfig(depth=cfg.mcts_depth, simulations=cfg.mcts_simulations, gamma=cfg.gamma)
+    mcfg = MCTSConfig(depth=cfg.mcts_depth, simulations=cfg.mcts_simulations, gamma=cfg.gamma,
+                      move_threshold=cfg.min_move_probability)
     C_states, C_obs = model.C_states[0], model.C[0]
     C_states[:n] = 0.0
     C_obs[: model.num_obs[0]] = 0.0

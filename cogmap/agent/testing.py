@@ -35,9 +35,10 @@ class BoxWorld:
     """Rectangle ``[0, width] x [0, height]`` with axis-aligned boxes ``(x0, y0, x1, y1)``."""
 
     def __init__(self, width: float = 6.0, height: float = 6.0, boxes=(), start=(1.0, 1.0), slip: float = 0.0,
-                 robot_radius: float = 0.22, step: float = 1.0, num_headings: int = 12):
+                 robot_radius: float = 0.22, step: float = 1.0, num_headings: int = 12, hidden=()):
         self.size = np.array([width, height], dtype=float)
         self.boxes = [tuple(map(float, b)) for b in boxes]
+        self.hidden = [tuple(map(float, b)) for b in hidden]  # block motion, unseen by the sensor
         self.true = np.array(start, dtype=float)
         self.odom = self.true.copy()
         self.slip = slip
@@ -48,15 +49,16 @@ class BoxWorld:
         self.dropped: set[int] = set()  # step numbers at which every sensor is silent
         self.steps = 0
 
-    def free(self, xy) -> bool:
+    def free(self, xy, boxes=None) -> bool:
         x, y = xy
         r = self.radius
         if not (r <= x <= self.size[0] - r and r <= y <= self.size[1] - r):
             return False
-        return not any(x0 - r < x < x1 + r and y0 - r < y < y1 + r for x0, y0, x1, y1 in self.boxes)
+        boxes = self.boxes if boxes is None else boxes
+        return not any(x0 - r < x < x1 + r and y0 - r < y < y1 + r for x0, y0, x1, y1 in boxes)
 
-    def segment_free(self, a, b, n: int = 20) -> bool:
-        return all(self.free(a + t * (b - a)) for t in np.linspace(0.0, 1.0, n))
+    def segment_free(self, a, b, n: int = 20, boxes=None) -> bool:
+        return all(self.free(a + t * (b - a), boxes) for t in np.linspace(0.0, 1.0, n))
 
     def obstacles(self) -> np.ndarray:
         h = 2 * np.pi * np.arange(self.num_headings) / self.num_headings
@@ -75,12 +77,16 @@ class BoxWorld:
             return True
         delta = np.asarray(decision.waypoint, dtype=float) - self.odom
         target = self.true + delta
-        ok = self.segment_free(self.true, target)
+        ok = self.segment_free(self.true, target, boxes=self.boxes + self.hidden)
         if ok:
             self.true = target
             self.odom = self.odom + delta * (1.0 + self.slip)
         self.path.append(self.true.copy())
         return ok
+
+    def odometry_jump(self, dxy) -> None:
+        """A wheel-slip event: odometry moves by ``dxy`` while the robot does not."""
+        self.odom = self.odom + np.asarray(dxy, dtype=float)
 
     def kidnap(self, xy) -> None:
         """Move the robot without telling odometry."""

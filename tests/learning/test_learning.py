@@ -61,14 +61,23 @@ def test_transition_events(sparse):
     assert B[0, 1, 2] == pytest.approx(5 / 6)
     learn_transition(model, 0, 0, 1, 1, Event.IMPOSSIBLE)
     B = model.live_B(0)
-    assert B[1, 0, 1] == pytest.approx(1e-3 / (1 + 1e-3))  # floored, stays positive
+    # -7 on the target (floored: counts stay positive), +7 on staying in place
+    assert B[1, 0, 1] == pytest.approx(1e-3 / (8 + 1e-3))
+    assert B[0, 0, 1] == pytest.approx(8 / (8 + 1e-3))
     assert model.live_pB(0).min() >= 0 and model.live_pB(0)[1, 0, 1] > 0
     np.testing.assert_allclose(B.sum(axis=0), 1.0)
     learn_transition(model, 0, 0, 1, 1, Event.PREDICTED_POSSIBLE)
-    assert model.live_B(0)[1, 0, 1] == pytest.approx((1e-3 + 5) / (1 + 1e-3 + 5))
+    assert model.live_B(0)[1, 0, 1] == pytest.approx((1e-3 + 5) / (8 + 1e-3 + 5))
     # the stay control is structural: never learned
     learn_transition(model, 0, 2, 0, 1, Event.POSSIBLE)
     np.testing.assert_array_equal(model.live_B(0)[:, :, 0], np.eye(3))
+    # a column reinforced many times is capped at the maximum concentration (forgetting)
+    for _ in range(10):
+        learn_transition(model, 0, 1, 1, 2, Event.POSSIBLE)
+    assert model.live_pB(0)[:, 1, 1].sum() == pytest.approx(TABLE7.max_concentration)
+    for _ in range(3):
+        learn_transition(model, 0, 1, 1, 2, Event.IMPOSSIBLE)
+    assert model.live_B(0)[2, 1, 1] < 0.05  # three blocked attempts overturn it
     with pytest.raises(SpecError, match="state 5 is not live"):
         learn_transition(model, 0, 0, 1, 5, Event.POSSIBLE)
 
