@@ -120,3 +120,34 @@ def test_moved_obstacle_suppresses_transitions_into_the_blocked_node():
         assert p_move(s, node) < 0.1 < max(p_move(s, n) for n in free)
     # it routes around: the robot never drove into the box
     assert not any(x - 0.52 < p[0] < x + 0.52 and y - 0.52 < p[1] < y + 0.52 for p in w.path[-25:])
+
+
+def box_world_astar(w: BoxWorld, start, goal, res: float = 0.05) -> float:
+    from cogmap.planning.astar import astar_grid
+
+    ny, nx = int(w.size[1] / res), int(w.size[0] / res)
+    ys, xs = (np.mgrid[0:ny, 0:nx] + 0.5) * res
+    occupied = ~np.vectorize(lambda x, y: w.free((x, y)))(xs, ys)
+    cell = lambda p: (int(p[1] / res), int(p[0] / res))  # noqa: E731
+    return astar_grid(occupied, cell(start), cell(goal), res)[1]
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_goal_reaching_follows_a_short_path(seed):
+    w = BoxWorld(8, 6, boxes=[(2.5, 1.5, 3.5, 4.5), (5, 2, 6, 6)], start=(1, 1))
+    agent = AIMAPPAgent(AgentConfig(), encoder=CellEncoder(), seed=seed)
+    _, moved = run(w, agent, 100)
+    visited = np.flatnonzero(agent.model.live_pA(0).max(axis=0) > 2 * agent.cfg.prior_count)
+    far = visited[np.argmax(np.hypot(*(agent.poses[visited] - w.true).T))]
+    assert np.hypot(*(agent.poses[far] - w.true)) > 4.0
+    agent.set_goal(int(agent.model.live_A(0)[:, far].argmax()))
+    start, first = w.true.copy(), len(w.path) - 1
+    for _ in range(40):
+        d = agent.step(w.sense(moved))
+        if agent.at_goal:
+            break
+        assert d.mode == "goal"
+        moved = w.act(d, agent.cfg.stay)
+    assert agent.at_goal
+    travelled = float(np.hypot(*np.diff(np.array(w.path[first:]), axis=0).T).sum())
+    assert travelled <= 2.0 * box_world_astar(w, start, w.true)
