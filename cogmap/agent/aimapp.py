@@ -50,7 +50,7 @@ class Decision:
     waypoint: np.ndarray  # odometry frame
     state: int
     target: int  # state the move is expected to reach (== state for stay / unknown)
-    mode: str  # "explore", "goal", "relocalise" or "paused"
+    mode: str  # "explore", "goal", "relocalise" (lost) or "paused" (a sensor is silent)
     confidence: Confidence | None = None
     expanded: int = 0
     efe: dict = field(default_factory=dict)
@@ -128,10 +128,14 @@ class AIMAPPAgent:
         return s
 
     def set_goal(self, obs: int | None) -> None:
-        """Prefer observation ``obs`` (goal mode), or return to exploration with ``None``."""
+        """Prefer observation ``obs`` (goal mode: C puts log-preference 1 on it, weighted by the
+        goal weight when planning), or return to exploration with ``None``."""
         if obs is not None and not 0 <= obs < self.model.num_obs[0]:
             raise ValueError(f"goal observation {obs} is unknown (have {self.model.num_obs[0]})")
         self.goal_obs = obs
+        self.model.C[0][:] = 0.0
+        if obs is not None:
+            self.model.C[0][obs] = 1.0
 
     def goal_states(self, min_prob: float = 0.5) -> np.ndarray:
         """States whose observation model favours the goal observation."""
@@ -141,31 +145,55 @@ class AIMAPPAgent:
         return np.flatnonzero(row >= max(min_prob * row.max(), 1e-9))
 
     def step(self, sensed: Sensed) -> Decision:
+        """One sense -> infer -> learn -> plan cycle; returns where to go next."""
         self.step_count += 1
         if self.last is not None and self._outcome is None and sensed.moved is not None:
-            self._outcome = bool(sensed.moved)
+            self._outcome = bool(sensed.moved)  # outcome of the last real motion command
         if sensed.panorama is None or sensed.odometry is None or sensed.obstacles is None:
-            state = -1 if self.last is None else self.last.state
-            here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
-            return Decision(self.cfg.stay, here, state, state, "paused")
-        cfg = self.cfg
+            return self._paused(sensed)
         pose = self.believed_pose(sensed.odometry)
         if self.model is None:
-            self.model = initial_model(cfg, pose)
+            self.model = initial_model(self.cfg, pose)
             self.q = np.ones(1)
-        obs, _ = self.encoder(sensed.panorama)
+        obs, score = self._observe(sensed.panorama)
+        q, conf = self._infer(obs, pose)
+        expanded = self._update(q, conf, obs, sensed, pose, score)
+        decision = self._decide(sensed, pose, conf, expanded)
+        self.last, self._outcome = decision, None
+        return decision
+
+    # -- the cycle -------------------------------------------------------------------------
+    def _paused(self, sensed: Sensed) -> Decision:
+        """A stream is silent: stay, change nothing, resume when it returns."""
+        state = -1 if self.last is None else self.last.state
+        here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
+        return Decision(self.cfg.stay, here, state, state, "paused")
+
+    def _observe(self, panorama) -> tuple[int, float]:
+        """Observation id (a new id grows A_o) and the encoder's best similarity score."""
+        obs, _ = self.encoder(panorama)
         self.last_obs = obs
-        score = float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
         while self.model.num_obs[0] <= obs:
             self.model.add_observation(0)
-        prior = self._visited_prior() if self.lost else self._prior(self._outcome)
-        if self.lost:
-            # Re-localisation: odometry is not trusted, only what is seen (section 3.3).
+        return obs, float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
+
+    def _infer(self, obs: int, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
+        """Posterior over states and the confidence test (section 3.3, A.1.2)."""
+        cfg = self.cfg
+        if self.lost:  # re-localising: odometry is not trusted, only what is seen
+            prior = self._visited_prior()
             q, _ = bayes_filter(self.model, [prior], [{"view": obs}])
-        else:
+        else:  # B_s prediction combined with A_o and A_p evidence
+            prior = self._prior(self._outcome)
             q, _ = bayes_filter(self.model, [prior], [{"view": obs, "pose": pose}])
         q = q[0]
         conf = assess(q, prior, self.model.live_A(0)[obs], cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
+        return q, conf
+
+    def _update(self, q: np.ndarray, conf: Confidence, obs: int, sensed: Sensed, pose: np.ndarray,
+                score: float) -> int:
+        """Lost/found bookkeeping and learning; returns how many states the map gained."""
+        cfg = self.cfg
         state = int(np.argmax(q))
         expanded = 0
         if self.lost:
@@ -185,24 +213,22 @@ class AIMAPPAgent:
                 learn_observation(self.model, 0, obs, [q], lr=cfg.obs_learning_rate)
         self.q = np.zeros(self.num_states)
         self.q[: q.size] = q
+        return expanded
+
+    def _decide(self, sensed: Sensed, pose: np.ndarray, conf: Confidence, expanded: int) -> Decision:
+        cfg = self.cfg
         state = int(np.argmax(self.q))
         if self.lost:
             # The map position is unknown, so the graph cannot guide a move: step in a free
             # direction of the real surroundings until a familiar view is recognised.
-            mode = "relocalise"
             free = np.flatnonzero(~np.asarray(sensed.obstacles, dtype=bool))
             action = int(self.rng.choice(free)) if free.size else cfg.stay
-            efe = {}
-            target = state
             waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
-        else:
-            mode = "goal" if self.goal_obs is not None else "explore"
-            action, efe = planner.decide(self, state, sensed.obstacles, mode)
-            target, waypoint = self._waypoint(state, action)
-        decision = Decision(action, waypoint - self.offset, state, target, mode, conf, expanded, efe)
-        self.last = decision
-        self._outcome = None
-        return decision
+            return Decision(action, waypoint - self.offset, state, state, "relocalise", conf, expanded)
+        mode = "goal" if self.goal_obs is not None else "explore"
+        action, efe = planner.decide(self, state, sensed.obstacles, mode)
+        target, waypoint = self._waypoint(state, action)
+        return Decision(action, waypoint - self.offset, state, target, mode, conf, expanded, efe)
 
     # -- pieces ------------------------------------------------------------------------------
     def _prior(self, moved: bool | None) -> np.ndarray:
