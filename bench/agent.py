@@ -1,9 +1,10 @@
 """Time per AIMAPP decision (infer + learn + plan) against the number of states.
 
-A long exploration of an unbounded open plane: no obstacles, odometry exact, and an encoder
-that names the 1 m cell the robot stands in (every place looks different), so the map keeps
-growing and the cost of one decision can be read at 50 ... 2,000 states without any simulator
-time mixed in. Also prints, for reference, the same agent in the pybullet mini warehouse.
+A long exploration of a 60 m x 60 m empty room (the numpy box world of
+``cogmap.agent.testing``): odometry exact and an encoder that names the 1 m cell the robot
+stands in (every place looks different), so the map keeps growing and the cost of one decision
+can be read at 50 ... 2,000 states without any simulator time mixed in.
+Also prints, for reference, the same agent in the pybullet mini warehouse.
 
     python bench/agent.py [--steps 2500]
 """
@@ -15,38 +16,23 @@ import time
 
 import numpy as np
 
-from cogmap.agent.aimapp import AIMAPPAgent, Sensed
+from cogmap.agent.aimapp import AIMAPPAgent
 from cogmap.agent.config import AgentConfig
-
-
-class CellEncoder:
-    """Observation id = index of the 1 m cell (ids assigned in order of first visit)."""
-
-    def __init__(self):
-        self.ids: dict[tuple[int, int], int] = {}
-        self.last_scores = np.zeros(0)
-
-    def __call__(self, pose) -> tuple[int, bool]:
-        key = (int(np.floor(pose[0])), int(np.floor(pose[1])))
-        new = key not in self.ids
-        if new:
-            self.ids[key] = len(self.ids)
-        self.last_scores = np.array([1.0])
-        return self.ids[key], new
+from cogmap.agent.testing import BoxWorld, CellEncoder
 
 
 def open_plane(steps: int, seed: int = 0):
+    """(states, ms) per decision in a 60 m x 60 m empty box world."""
     cfg = AgentConfig(influence_radius=1.0, initial_capacity=64)
-    agent = AIMAPPAgent(cfg, encoder=CellEncoder(), seed=seed)
-    pose = np.zeros(3)
-    free = np.zeros(cfg.num_headings, dtype=bool)
-    samples = []
+    world = BoxWorld(60.0, 60.0, start=(30.0, 30.0))
+    agent = AIMAPPAgent(cfg, encoder=CellEncoder(1.0), seed=seed)
+    samples, moved = [], None
     for _ in range(steps):
+        sensed = world.sense(moved)
         t0 = time.perf_counter()
-        d = agent.step(Sensed(pose[:2].copy(), free, pose.copy(), True))
+        d = agent.step(sensed)
         samples.append((agent.num_states, 1e3 * (time.perf_counter() - t0)))
-        if d.action != cfg.stay:
-            pose[:2] = d.waypoint
+        moved = world.act(d, cfg.stay)
     return np.array(samples)
 
 
