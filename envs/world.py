@@ -2,11 +2,23 @@
 
 from __future__ import annotations
 
+import shutil
+import tempfile
+from pathlib import Path
+
 import numpy as np
 import pybullet as p
 
 from .geometry import Box, Cylinder
 from .layouts import Layout
+from .textures import (
+    box_mesh,
+    cylinder_mesh,
+    layout_floor_texture,
+    quad_mesh,
+    shape_texture,
+    write_png,
+)
 
 FLOOR_RGBA = (0.55, 0.55, 0.5, 1.0)
 
@@ -15,23 +27,53 @@ def _quat(yaw: float):
     return (0.0, 0.0, float(np.sin(yaw / 2)), float(np.cos(yaw / 2)))
 
 
-class PyBulletScene:
-    """Static shapes as zero-mass bodies, a cylinder robot, rays and a pinhole camera."""
+WHITE = (1.0, 1.0, 1.0, 1.0)
 
-    def __init__(self, layout: Layout, robot_radius: float = 0.22, robot_height: float = 0.2):
+
+class PyBulletScene:
+    """Static shapes as zero-mass bodies, a cylinder robot, rays and a pinhole camera.
+
+    With `textured` (the default) every shape and the floor are textured meshes whose
+    seeded patterns (see `textures`) give camera images structure; collision shapes stay
+    primitive boxes and cylinders. Texture PNGs are written to a temporary directory that
+    is removed once pybullet has loaded them.
+    """
+
+    def __init__(self, layout: Layout, robot_radius: float = 0.22, robot_height: float = 0.2,
+                 textured: bool = True):
         self.client = p.connect(p.DIRECT)
         self.bodies: dict[str, int] = {}
         self.heights: dict[str, float] = {}
+        self.textured = textured
+        self.layout_name = layout.name
         cid = self.client
-        xmin, ymin, xmax, ymax = layout.bounds
-        half = [(xmax - xmin) / 2 + 1.0, (ymax - ymin) / 2 + 1.0, 0.01]
-        vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=FLOOR_RGBA,
-                                  physicsClientId=cid)
-        self.floor = p.createMultiBody(0, -1, vis, [(xmin + xmax) / 2, (ymin + ymax) / 2, -0.01],
-                                       physicsClientId=cid)
-        for s in layout.shapes:
-            self.bodies[s.name] = self._add(s)
-            self.heights[s.name] = s.height
+        tmp = Path(tempfile.mkdtemp(prefix="cogmap_tex_")) if textured else None
+        try:
+            xmin, ymin, xmax, ymax = layout.bounds
+            size = ((xmax - xmin) + 2.0, (ymax - ymin) + 2.0)
+            centre = [(xmin + xmax) / 2, (ymin + ymax) / 2]
+            if textured:
+                v, i, uv, n = quad_mesh(*size)
+                vis = p.createVisualShape(p.GEOM_MESH, vertices=v, indices=i, uvs=uv, normals=n,
+                                          rgbaColor=WHITE, physicsClientId=cid)
+                self.floor = p.createMultiBody(0, -1, vis, [*centre, 0.0], physicsClientId=cid)
+                tex = layout_floor_texture(layout.name, size, FLOOR_RGBA[:3])
+                self._texture(self.floor, tex, tmp / "floor.png")
+            else:
+                half = [size[0] / 2, size[1] / 2, 0.01]
+                vis = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=FLOOR_RGBA,
+                                          physicsClientId=cid)
+                self.floor = p.createMultiBody(0, -1, vis, [*centre, -0.01],
+                                               physicsClientId=cid)
+            for k, s in enumerate(layout.shapes):
+                self.bodies[s.name] = self._add(s)
+                self.heights[s.name] = s.height
+                if textured:
+                    self._texture(self.bodies[s.name], shape_texture(layout.name, s),
+                                  tmp / f"shape_{k:04d}.png")
+        finally:
+            if tmp is not None:
+                shutil.rmtree(tmp, ignore_errors=True)
         col = p.createCollisionShape(p.GEOM_CYLINDER, radius=robot_radius, height=robot_height,
                                      physicsClientId=cid)
         # a tiny invisible visual keeps the robot out of its own camera images
@@ -43,20 +85,36 @@ class PyBulletScene:
         self.names = {v: k for k, v in self.bodies.items()}
         self._proj = {}
 
+    def _texture(self, body: int, rgb: np.ndarray, path: Path) -> None:
+        write_png(path, rgb)
+        tex = p.loadTexture(str(path), physicsClientId=self.client)
+        p.changeVisualShape(body, -1, textureUniqueId=tex, physicsClientId=self.client)
+
+    def _mesh(self, mesh) -> int:
+        v, i, uv, n = mesh
+        return p.createVisualShape(p.GEOM_MESH, vertices=v, indices=i, uvs=uv, normals=n,
+                                   rgbaColor=WHITE, physicsClientId=self.client)
+
     def _add(self, s) -> int:
         cid = self.client
         rgba = (*s.color, 1.0)
         if isinstance(s, Box):
             he = [s.sx / 2, s.sy / 2, s.height / 2]
             col = p.createCollisionShape(p.GEOM_BOX, halfExtents=he, physicsClientId=cid)
-            vis = p.createVisualShape(p.GEOM_BOX, halfExtents=he, rgbaColor=rgba,
-                                      physicsClientId=cid)
+            if self.textured:
+                vis = self._mesh(box_mesh(s.sx, s.sy, s.height))
+            else:
+                vis = p.createVisualShape(p.GEOM_BOX, halfExtents=he, rgbaColor=rgba,
+                                          physicsClientId=cid)
             yaw = s.yaw
         elif isinstance(s, Cylinder):
             col = p.createCollisionShape(p.GEOM_CYLINDER, radius=s.radius, height=s.height,
                                          physicsClientId=cid)
-            vis = p.createVisualShape(p.GEOM_CYLINDER, radius=s.radius, length=s.height,
-                                      rgbaColor=rgba, physicsClientId=cid)
+            if self.textured:
+                vis = self._mesh(cylinder_mesh(s.radius, s.height))
+            else:
+                vis = p.createVisualShape(p.GEOM_CYLINDER, radius=s.radius, length=s.height,
+                                          rgbaColor=rgba, physicsClientId=cid)
             yaw = 0.0
         else:  # pragma: no cover - layouts only hold boxes and cylinders
             raise TypeError(f"unsupported shape {s!r}")
