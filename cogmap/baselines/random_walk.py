@@ -1,0 +1,28 @@
+"""Random walk: a uniformly random heading each decision, one step length in the odometry frame.
+
+Uses only odometry (the move is commanded relative to the believed pose, like every agent);
+a move into an obstacle stops before the collision and counts as a failed move.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class RandomWalk:
+    mode = "random"
+
+    def __init__(self, step_length: float = 1.0, seed: int = 0):
+        self.step_length = float(step_length)
+        self.rng = np.random.default_rng(seed)
+
+    def step(self, sim, moved: bool | None):
+        odom = sim.odometry()
+        h = float(self.rng.uniform(0.0, 2 * np.pi))
+        if odom is None:  # no odometry: move blind relative to the true pose cannot be commanded
+            return sim.true_pose()[:2], "world"
+        return odom[:2] + self.step_length * np.array([np.cos(h), np.sin(h)]), "odom"
+
+    def believed_pose(self, sim) -> np.ndarray:
+        odom = sim.odometry()
+        return np.full(2, np.nan) if odom is None else odom[:2]

@@ -1,0 +1,99 @@
+"""Study definitions: environments, methods, seeds and budgets per study and scale."""
+
+from __future__ import annotations
+
+STUDIES = ("exploration", "success", "goals", "drift", "obstacle", "scaling")
+METHODS = ("aimapp", "frontier", "random", "oracle")
+
+# decision budget per environment (a run also ends at STOP_COVERAGE or when a baseline finishes)
+STEPS_FULL = {
+    "mini_warehouse": 60, "small_warehouse": 100, "bedroom": 50, "random_rooms": 150,
+    "house": 300, "large_warehouse": 300, "aisle_warehouse": 300, "parking_lot": 300,
+}
+STEPS_REDUCED = {"mini_warehouse": 40, "small_warehouse": 60}
+STOP_COVERAGE = 0.99
+SUCCESS_COVERAGE = 0.9
+
+ALL_ENVS = ("mini_warehouse", "small_warehouse", "large_warehouse", "house", "aisle_warehouse", "bedroom",
+            "parking_lot")
+
+DRIFT_LEVELS = {
+    "none": {"slip": 0.0, "heading_bias": 0.0},
+    "moderate": {"slip": 0.03, "heading_bias": 0.02},
+    "severe": {"slip": 0.08, "heading_bias": 0.05},
+}
+
+
+def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
+    """Environments, methods, seeds and parameters of a study at a scale."""
+    if study not in STUDIES:
+        raise ValueError(f"unknown study {study!r}; choose from {STUDIES}")
+    if scale not in ("reduced", "full", "tiny"):
+        raise ValueError("scale must be 'reduced', 'full' or 'tiny'")
+    full = scale == "full"
+    tiny = scale == "tiny"
+    plan: dict = {"study": study, "scale": scale, "stop_coverage": STOP_COVERAGE,
+                  "success_coverage": SUCCESS_COVERAGE, "params": {}}
+    if study in ("exploration", "success"):
+        plan["envs"] = list(ALL_ENVS if full else ("mini_warehouse", "small_warehouse"))
+        plan["methods"] = list(METHODS if study == "exploration" else ("aimapp", "frontier", "random"))
+        plan["seeds"] = list(range(5 if full else 3))
+        plan["steps"] = STEPS_FULL if full else STEPS_REDUCED
+    elif study == "goals":
+        plan["envs"] = list(("mini_warehouse", "small_warehouse", "house", "large_warehouse") if full
+                            else ("mini_warehouse", "small_warehouse"))
+        plan["methods"] = ["aimapp"]
+        plan["seeds"] = list(range(5 if full else 2))
+        plan["steps"] = {"mini_warehouse": 60, "small_warehouse": 100, "house": 250, "large_warehouse": 250}
+        plan["params"] = {"goals_per_run": 2, "goal_steps": 60, "min_goal_distance": 1.5}
+    elif study == "drift":
+        plan["envs"] = ["aisle_warehouse" if full else "small_warehouse"]
+        plan["methods"] = ["aimapp", "frontier", "oracle"]
+        plan["seeds"] = list(range(5 if full else 2))
+        plan["steps"] = {"aisle_warehouse": 300, "small_warehouse": 60}
+        plan["params"] = {"levels": list(DRIFT_LEVELS) if full else ["none", "severe"]}
+    elif study == "obstacle":
+        plan["envs"] = ["mini_warehouse"]
+        plan["methods"] = ["aimapp"]
+        plan["seeds"] = list(range(3 if full else 1))
+        plan["steps"] = {"mini_warehouse": 30}
+        plan["params"] = {"after_steps": 40, "box": "central_box"}
+    elif study == "scaling":
+        plan["envs"] = list(("large_warehouse", "house", "parking_lot") if full else ("small_warehouse",))
+        plan["methods"] = ["aimapp"]
+        plan["seeds"] = list(range(3 if full else 1))
+        plan["steps"] = {"large_warehouse": 300, "house": 300, "parking_lot": 300, "small_warehouse": 60}
+        plan["params"] = {"size_every": 20}
+    if tiny:
+        plan["envs"] = plan["envs"][:1]
+        plan["seeds"] = plan["seeds"][:2]
+        plan["steps"] = {e: 6 for e in plan["envs"]}
+        if study == "goals":
+            plan["params"] = {**plan["params"], "goals_per_run": 1, "goal_steps": 5}
+        if study == "obstacle":
+            plan["params"] = {**plan["params"], "after_steps": 5}
+    if envs is not None:
+        plan["envs"] = list(envs)
+    if seeds is not None:
+        plan["seeds"] = list(seeds)
+    if methods is not None:
+        plan["methods"] = list(methods)
+    plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, 100))) for e in plan["envs"]}
+    return plan
+
+
+def run_specs(plan: dict) -> list[dict]:
+    """One JSON-able spec per run: (study, env, method, seed, config)."""
+    specs = []
+    levels = plan["params"].get("levels", [None])
+    for env in plan["envs"]:
+        for method in plan["methods"]:
+            for level in levels:
+                for seed in plan["seeds"]:
+                    key = f"{env}__{method}__s{seed}" + (f"__{level}" if level is not None else "")
+                    specs.append({
+                        "key": key, "study": plan["study"], "env": env, "method": method, "seed": int(seed),
+                        "level": level, "steps": plan["steps"][env], "stop_coverage": plan["stop_coverage"],
+                        "success_coverage": plan["success_coverage"], "params": plan["params"],
+                    })
+    return specs

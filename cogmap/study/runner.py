@@ -1,0 +1,181 @@
+"""Run a study: every run once, in parallel, resumable; then tables, CSV, figures, study.json.
+
+Layout of ``<out>/<study>/``::
+
+    runs/<key>.json   one finished run each (written to a temporary file, then os.replace)
+    study.json        plan, seeds, package versions, git commit, wall-clock times
+    table.md, table.csv, *.png
+
+A run whose JSON exists is never redone, so an interrupted study resumes where it stopped.
+Executors: ``local`` (``ProcessPoolExecutor``; ``workers=1`` runs in-process) or ``ray``
+(each run a Ray task; ``ray.init(address=...)``); results are the same per seed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from pathlib import Path
+
+from .config import STUDIES, run_specs, study_plan
+from .runs import execute
+
+
+def write_json_atomic(path: Path, data) -> None:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    with open(tmp, "w") as fh:
+        json.dump(data, fh, indent=1, allow_nan=False)
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def load_runs(study_dir: Path) -> dict[str, dict]:
+    out = {}
+    for p in sorted((Path(study_dir) / "runs").glob("*.json")):
+        try:
+            out[p.stem] = json.loads(p.read_text())
+        except (OSError, json.JSONDecodeError):  # a torn file cannot exist (atomic), but be safe
+            continue
+    return out
+
+
+def _run_local(specs, workers: int, sink) -> None:
+    if workers <= 1:
+        for s in specs:
+            sink(execute(s))
+        return
+    import multiprocessing as mp
+
+    ctx = mp.get_context("spawn")  # pybullet and jax do not like fork
+    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+        futures = [pool.submit(execute, s) for s in specs]
+        for f in as_completed(futures):
+            sink(f.result())
+
+
+def _run_ray(specs, workers: int, address: str | None, sink) -> None:
+    import ray
+
+    started = False
+    if not ray.is_initialized():
+        kw = {"include_dashboard": False, "log_to_driver": False, "ignore_reinit_error": True}
+        if address:
+            ray.init(address=address, **kw)
+        else:
+            ray.init(num_cpus=max(1, workers), **kw)
+        started = True
+    try:
+        remote = ray.remote(num_cpus=1)(execute)
+        pending = [remote.remote(s) for s in specs]
+        while pending:
+            done, pending = ray.wait(pending, num_returns=1)
+            for ref in done:
+                sink(ray.get(ref))
+    finally:
+        if started:
+            ray.shutdown()
+
+
+def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None, scale: str = "reduced",
+              workers: int = 1, executor: str = "local", address: str | None = None, limit: int | None = None,
+              progress: bool = True, report: bool = True) -> dict:
+    """Run (or resume) study ``name`` under ``out_dir/name``; returns the summary dict.
+
+    ``limit`` runs at most that many of the missing runs (then stops, as if interrupted)."""
+    from tqdm import tqdm
+
+    from cogmap.runs import git_commit, versions
+
+    plan = study_plan(name, scale, envs=envs, seeds=seeds, methods=methods)
+    specs = run_specs(plan)
+    study_dir = Path(out_dir) / name
+    runs_dir = study_dir / "runs"
+    runs_dir.mkdir(parents=True, exist_ok=True)
+    done = load_runs(study_dir)
+    todo = [s for s in specs if s["key"] not in done]
+    if limit is not None:
+        todo = todo[:limit]
+    t0 = time.perf_counter()
+    bar = tqdm(total=len(specs), initial=len(specs) - len([s for s in specs if s["key"] not in done]),
+               disable=not progress, desc=f"{name} runs", unit="run")
+
+    def sink(res):
+        write_json_atomic(runs_dir / f"{res['key']}.json", res)
+        done[res["key"]] = res
+        bar.update(1)
+        bar.set_postfix_str(res["key"])
+
+    try:
+        if todo:
+            if executor == "local":
+                _run_local(todo, workers, sink)
+            elif executor == "ray":
+                _run_ray(todo, workers, address, sink)
+            else:
+                raise ValueError("executor must be 'local' or 'ray'")
+    finally:
+        bar.close()
+    elapsed = time.perf_counter() - t0
+    results = [done[s["key"]] for s in specs if s["key"] in done]
+    complete = len(results) == len(specs)
+    meta_path = study_dir / "study.json"
+    prev = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+    meta = {
+        "study": name, "plan": plan, "seeds": plan["seeds"], "runs_total": len(specs), "runs_done": len(results),
+        "complete": complete, "executor": executor, "workers": workers,
+        "versions": versions(), "commit": git_commit(),
+        "sessions": prev.get("sessions", []) + [{"ran": len(todo), "wall_s": round(elapsed, 1), "executor": executor,
+                                                 "workers": workers}],
+        "run_wall_s_total": round(sum(r.get("wall_s", 0.0) for r in results), 1),
+    }
+    meta["wall_s_total"] = round(sum(s["wall_s"] for s in meta["sessions"]), 1)
+    write_json_atomic(meta_path, meta)
+    summary = {"study_dir": str(study_dir), "complete": complete, "runs": len(results), "total": len(specs),
+               "wall_s": elapsed}
+    if report and results:
+        from .report import write_report
+
+        summary["table"] = write_report(name, study_dir, plan, results, meta)
+    return summary
+
+
+def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.ArgumentParser:
+    p = parser or argparse.ArgumentParser(prog="cogmap reproduce", description="Reproduce a study of the paper")
+    p.add_argument("study", choices=STUDIES)
+    p.add_argument("--out", default="results", help="output directory (default: results/)")
+    p.add_argument("--scale", default="reduced", choices=("reduced", "full", "tiny"))
+    p.add_argument("--workers", type=int, default=1)
+    p.add_argument("--executor", default="local", choices=("local", "ray"))
+    p.add_argument("--address", default=None, help="Ray cluster address (default: start a local Ray)")
+    p.add_argument("--seeds", type=int, nargs="*", default=None)
+    p.add_argument("--envs", nargs="*", default=None)
+    p.add_argument("--methods", nargs="*", default=None)
+    p.add_argument("--limit", type=int, default=None, help="run at most this many missing runs")
+    p.add_argument("--quiet", action="store_true")
+    return p
+
+
+def run_from_args(args) -> int:
+    summary = run_study(args.study, args.out, seeds=args.seeds, envs=args.envs, methods=args.methods,
+                        scale=args.scale, workers=args.workers, executor=args.executor, address=args.address,
+                        limit=args.limit, progress=not args.quiet)
+    if summary.get("table"):
+        print(summary["table"])
+    print(f"{summary['runs']}/{summary['total']} runs in {summary['study_dir']} "
+          f"({summary['wall_s']:.0f} s this session)")
+    return 0 if summary["complete"] else 3
+
+
+def main(argv=None) -> int:
+    return run_from_args(build_parser().parse_args(argv))
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

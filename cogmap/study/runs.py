@@ -1,0 +1,305 @@
+"""One study run = a pure function of its spec (study, env, method, seed, config) returning a
+JSON-able dict. Runs are deterministic per seed except the fields ending in ``_ms`` /
+``_s`` (wall-clock timings)."""
+
+from __future__ import annotations
+
+import copy
+import math
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+from .metrics_extra import (
+    count_stalls,
+    drift_metrics,
+    graph_plan_length,
+    is_success,
+    nauc_budget,
+    nauc_over_budget,
+    path_length_ratios,
+    transitions_into,
+)
+
+TIMING_SUFFIXES = ("_ms", "_s")
+
+
+def _clean(x):
+    """numpy scalars/arrays -> Python; non-finite floats -> None (strict JSON)."""
+    if isinstance(x, dict):
+        return {str(k): _clean(v) for k, v in x.items()}
+    if isinstance(x, list | tuple):
+        return [_clean(v) for v in x]
+    if isinstance(x, np.ndarray):
+        return _clean(x.tolist())
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return x
+
+
+def _noise(spec):
+    from cogmap.envs import OdometryNoise
+    from cogmap.study.config import DRIFT_LEVELS
+
+    level = spec.get("level")
+    return OdometryNoise(**DRIFT_LEVELS[level]) if level else None
+
+
+def _curve(ep, points: int = 120) -> dict:
+    d, c = np.asarray(ep.distance), np.asarray(ep.coverage)
+    idx = np.unique(np.linspace(0, len(d) - 1, min(points, len(d))).round().astype(int))
+    return {"distance": [round(float(v), 3) for v in d[idx]], "coverage": [round(float(v), 4) for v in c[idx]]}
+
+
+def explore_episode(env: str, method: str, seed: int, steps: int, stop_coverage: float | None, noise=None):
+    """Run one method in a fresh simulator; returns (sim, episode, agent-or-policy). Caller closes sim."""
+    from cogmap.agent.aimapp import AIMAPPAgent
+    from cogmap.baselines import FrontierConfig, FrontierExplorer, OracleConfig, OracleTour, RandomWalk, run_policy
+    from cogmap.explore import default_config, make_sim, run_agent
+
+    cfg = default_config(env)
+    sim = make_sim(env, cfg, seed, noise)
+    step = cfg.influence_radius
+    if method == "aimapp":
+        agent = AIMAPPAgent(cfg, seed=seed)
+        stop = None
+        if stop_coverage is not None:
+            def stop(_d):
+                return sim._coverage.coverage >= stop_coverage
+        ep = run_agent(sim, agent, steps, progress=False, stop=stop)
+        return sim, ep, agent
+    if method == "frontier":
+        pol = FrontierExplorer(FrontierConfig(step_length=step, robot_radius=sim.config.robot_radius,
+                                              lidar_range=sim.config.lidar_range))
+    elif method == "random":
+        pol = RandomWalk(step, seed=seed)
+    elif method == "oracle":
+        pol = OracleTour(OracleConfig(step_length=step, robot_radius=sim.config.robot_radius,
+                                      lidar_range=sim.config.lidar_range))
+    else:
+        raise ValueError(f"unknown method {method!r}")
+    ep = run_policy(sim, pol, steps, stop_coverage=stop_coverage)
+    return sim, ep, pol
+
+
+def exploration_result(spec, sim, ep) -> dict:
+    from cogmap.explore import episode_metrics
+
+    m = episode_metrics(sim, ep)
+    moved = [r["moved"] for r in ep.rows]
+    cov_rows = [r["coverage"] for r in ep.rows]
+    stalls = count_stalls(moved, cov_rows, target=spec["stop_coverage"])
+    budget = nauc_budget(m["free_area_m2"])
+    truth = [[r["true_x"], r["true_y"]] for r in ep.rows]
+    odom = [[r["odom_x"], r["odom_y"]] for r in ep.rows]
+    belief = [[r["belief_x"], r["belief_y"]] for r in ep.rows]
+    out = {
+        "coverage": m["coverage"], "area_covered_m2": m["area_covered_m2"], "free_area_m2": m["free_area_m2"],
+        "distance_m": m["distance_m"], "steps": m["steps"], "ce": m["coverage_efficiency"],
+        "nauc": nauc_over_budget(ep.distance, ep.coverage, budget), "nauc_budget_m": budget,
+        "nauc_own_distance": m["nauc"], "failed_moves": m["failed_moves"], "stalls": stalls,
+        "success": is_success(m["coverage"], stalls, spec["success_coverage"]),
+        "num_states": m["num_states"], "num_observations": m["num_observations"],
+        "decision_mean_ms": m["decision_ms_mean"], "decision_p95_ms": m["decision_ms_p95"],
+        **(drift_metrics(truth, odom, belief) if ep.rows else {}),
+        "curve": _curve(ep),
+    }
+    return out
+
+
+def run_exploration(spec) -> dict:
+    sim, ep, _ = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], spec["stop_coverage"],
+                                 _noise(spec))
+    try:
+        return exploration_result(spec, sim, ep)
+    finally:
+        sim.close()
+
+
+def run_drift(spec) -> dict:
+    out = run_exploration(spec)
+    out.pop("curve", None)
+    out["level"] = spec["level"]
+    return out
+
+
+def _choose_goals(agent, start_state: int, k: int, min_dist: float) -> list[tuple[int, list[int]]]:
+    """Up to ``k`` stored observations whose states lie farthest (stored pose) from the start."""
+    poses = agent.poses
+    cands = []
+    saved = agent.goal_obs
+    for o in range(agent.model.num_obs[0]):
+        agent.set_goal(o)
+        gs = [int(s) for s in np.atleast_1d(agent.goal_states())]
+        if not gs or start_state in gs:
+            continue
+        d = float(np.min(np.hypot(*(poses[gs] - poses[start_state]).T)))
+        if d >= min_dist:
+            cands.append((d, o, gs))
+    agent.set_goal(saved)
+    cands.sort(key=lambda t: (-t[0], t[1]))
+    return [(o, gs) for _, o, gs in cands[:k]]
+
+
+def run_goals(spec) -> dict:
+    """Explore, then from the exploration start (known) pursue stored goal observations."""
+    from cogmap.explore import default_config, make_sim
+    from cogmap.goal import pursue
+
+    p = spec["params"]
+    sim, ep, agent = explore_episode(spec["env"], "aimapp", spec["seed"], spec["steps"], None)
+    explore_cov = float(ep.coverage[-1])
+    sim.close()
+    cfg = default_config(spec["env"])
+    base = copy.deepcopy(agent)
+    sim = make_sim(spec["env"], cfg, spec["seed"])
+    try:
+        start_state = base.localise_at(sim.odometry())
+        goals = _choose_goals(base, start_state, p["goals_per_run"], p["min_goal_distance"])
+    finally:
+        sim.close()
+    results = []
+    for gi, (obs, goal_states) in enumerate(goals):
+        ag = copy.deepcopy(base)
+        ag.rng = np.random.default_rng([spec["seed"], gi])
+        sim = make_sim(spec["env"], cfg, spec["seed"])
+        try:
+            s0 = ag.localise_at(sim.odometry())
+            plan_m = graph_plan_length(ag.model.B[0], ag.poses, s0, goal_states, cfg.inductive_threshold)
+            gep, summary = pursue(sim, ag, obs, p["goal_steps"], progress=False)
+            res = {"goal": gi, "goal_obs": obs, "goal_states": goal_states, "reached": summary["reached"],
+                   "steps": summary["steps"], "executed_m": summary["executed_m"], "astar_m": summary["astar_m"],
+                   "plan_m": plan_m,
+                   **path_length_ratios(summary["executed_m"], summary["astar_m"], plan_m)}
+            results.append(res)
+        finally:
+            sim.close()
+    return {"explore_steps": len(ep.rows), "explore_coverage": explore_cov, "num_states": base.num_states,
+            "num_observations": int(base.model.num_obs[0]), "goals": results}
+
+
+def run_obstacle(spec) -> dict:
+    """Figure 8: explore, move a box onto a free node the agent knows, track the belief of
+    transitions into that node."""
+    from cogmap.agent.aimapp import AIMAPPAgent
+    from cogmap.explore import default_config, make_sim, run_agent
+
+    p = spec["params"]
+    cfg = default_config(spec["env"])
+    sim = make_sim(spec["env"], cfg, spec["seed"])
+    try:
+        agent = AIMAPPAgent(cfg, seed=spec["seed"])
+        trace = []
+
+        def record(phase):
+            B = agent.model.B[0]
+            n = agent.num_states
+            t = transitions_into(B.succ, B.prob, node, n) if node is not None else None
+            trace.append({"step": sim.step_count, "phase": phase, **(t or {})})
+
+        node = None
+        ep = run_agent(sim, agent, spec["steps"], progress=False)
+        box = sim.layout.shape(p["box"])
+        half = max(getattr(box, "sx", 0.0), getattr(box, "sy", 0.0)) / 2
+        robot = sim.true_pose()[:2]
+        B = agent.model.B[0]
+        n = agent.num_states
+        best = None
+        for s in range(n):
+            xy = agent.poses[s]
+            if np.hypot(*(xy - robot)) < half + sim.config.robot_radius + 0.6:
+                continue
+            if np.hypot(xy[0] - box.x, xy[1] - box.y) < 2 * half + 0.3:  # must be a new place
+                continue
+            if not _box_fits(sim, p["box"], xy):
+                continue
+            incoming = transitions_into(B.succ, B.prob, s, n)["above_half"]
+            if best is None or incoming > best[0]:
+                best = (incoming, s)
+        if best is None:
+            return {"node": None, "trace": [], "note": "no free node to block"}
+        node = best[1]
+        target = agent.poses[node].copy()
+        record("before")
+        sim.schedule_obstacle_move(p["box"], target, at_step=sim.step_count + 1)
+        for _ in range(p["after_steps"]):
+            run_agent(sim, agent, 1, progress=False, episode=ep)
+            record("after")
+        return {"node": int(node), "node_pose": target.tolist(), "moved_at_step": trace[0]["step"] + 1,
+                "trace": trace, "failed_moves": int(sum(1 for r in ep.rows if r["moved"] is False))}
+    finally:
+        sim.close()
+
+
+def _box_fits(sim, name, xy) -> bool:
+    """The box moved to ``xy`` overlaps no other shape and stays inside the room."""
+    from cogmap.envs.geometry import ShapeSet
+
+    moved = sim.layout.with_moved(name, xy)
+    box = moved.shape(name)
+    others = ShapeSet([s for s in moved.shapes if s.name != name])
+    hx, hy = box.sx / 2, box.sy / 2
+    pts = np.array([[box.x + a * hx, box.y + b * hy] for a in (-1, 0, 1) for b in (-1, 0, 1)])
+    xmin, ymin, xmax, ymax = moved.bounds
+    inside = (pts[:, 0] > xmin) & (pts[:, 0] < xmax) & (pts[:, 1] > ymin) & (pts[:, 1] < ymax)
+    return bool(inside.all() and np.all(others.distance(pts) > 0.05))
+
+
+def model_size_bytes(model) -> int:
+    from cogmap.genmodel.io import save
+
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = save(model, Path(tmp) / "model")
+        return int(sum(Path(q).stat().st_size for q in paths))
+
+
+def run_scaling(spec) -> dict:
+    """Figure 13: time per decision against the number of states; model size against the
+    number of stored observations."""
+    from cogmap.agent.aimapp import AIMAPPAgent
+    from cogmap.explore import default_config, make_sim, run_agent
+
+    every = spec["params"]["size_every"]
+    cfg = default_config(spec["env"])
+    sim = make_sim(spec["env"], cfg, spec["seed"])
+    try:
+        agent = AIMAPPAgent(cfg, seed=spec["seed"])
+        sizes = []
+
+        def on_step(_d):
+            if agent.step_count % every == 0:
+                sizes.append({"step": agent.step_count, "num_states": agent.num_states,
+                              "num_observations": int(agent.model.num_obs[0]),
+                              "model_bytes": model_size_bytes(agent.model)})
+
+        ep = run_agent(sim, agent, spec["steps"], progress=False, on_step=on_step)
+        sizes.append({"step": agent.step_count, "num_states": agent.num_states,
+                      "num_observations": int(agent.model.num_obs[0]), "model_bytes": model_size_bytes(agent.model)})
+        return {"num_states": [int(v) for v in ep.num_states], "decision_ms": [round(v, 3) for v in ep.decision_ms],
+                "sizes": sizes, "coverage": float(ep.coverage[-1])}
+    finally:
+        sim.close()
+
+
+RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
+           "obstacle": run_obstacle, "scaling": run_scaling}
+
+
+def execute(spec: dict) -> dict:
+    """Run one spec and return ``{"spec": spec, "result": ..., "wall_s": ...}`` (JSON-able)."""
+    t0 = time.perf_counter()
+    result = RUNNERS[spec["study"]](spec)
+    return _clean({"key": spec["key"], "spec": spec, "result": result, "wall_s": time.perf_counter() - t0})
+
+
+def strip_timings(x):
+    """The deterministic part of a result (timing fields removed) for comparisons."""
+    if isinstance(x, dict):
+        return {k: strip_timings(v) for k, v in x.items() if not k.endswith(TIMING_SUFFIXES) and k != "decision_ms"}
+    if isinstance(x, list):
+        return [strip_timings(v) for v in x]
+    return x
