@@ -18,6 +18,8 @@ from .geometry import Box, Cylinder, Shape
 
 WALL = 0.15
 WALL_H = 2.0
+OPENING = 1.6  # width of doorless openings between rooms: a 1 m lattice with 30-degree
+# headings passes a 0.32 m corridor half-width through them off-centre
 Pose = tuple[float, float, float]
 
 
@@ -176,10 +178,11 @@ def large_warehouse(seed: int = 0) -> Layout:
     for i, y in enumerate((3.3, 6.6, 9.9, 13.2)):
         b.box("rack", 11.0, y, 14.0, 1.0, 2.2, rack_colors[i])
     _forklift(b, 2.0, 1.4 + b.jitter(0.2), 0.0)
-    _forklift(b, 19.5, 8.2 + b.jitter(0.2), np.pi / 2)
-    _forklift(b, 9.0 + b.jitter(0.5), 15.4, np.pi)
+    # racks span x 4-18, y 2.8-13.7: forklifts leave >= 1.6 m to the rack ends and rows
+    _forklift(b, 20.2, 8.2 + b.jitter(0.2), np.pi / 2)
+    _forklift(b, 9.0 + b.jitter(0.5), 15.75, np.pi)
     for _ in range(6):
-        x = float(b.rng.choice([1.0, 20.9]))
+        x = float(b.rng.choice([1.0, 21.3]))
         y = float(b.rng.uniform(3.0, 14.0))
         b.box("pallet", x, y, 1.0, 1.0, 0.9, PALLET)
     return b.layout("large_warehouse", bounds,
@@ -195,11 +198,14 @@ def house(seed: int = 0) -> Layout:
     t = 0.12
     kitchen, play = (0.95, 0.9, 0.55), (0.95, 0.7, 0.85)
     # interior walls with doorless openings
-    b.hwall(6.5, 0.0, w, gaps=[(6.0, 7.6), (13.8, 15.0)], t=t)
-    b.vwall(5.0, 0.0, 6.5, gaps=[(2.4, 4.0)], t=t, color=kitchen)
-    b.vwall(12.0, 0.0, 6.5, gaps=[(1.4, 2.6)], t=t, color=play)
-    b.vwall(5.5, 6.5, h, gaps=[(8.8, 9.8)], t=t, color=(0.8, 0.9, 0.7))
-    b.vwall(8.0, 6.5, h, gaps=[(10.2, 11.2)], t=t, color=(0.9, 0.8, 0.6))
+    def door(mid):
+        return (mid - OPENING / 2, mid + OPENING / 2)
+
+    b.hwall(6.5, 0.0, w, gaps=[door(6.8), door(14.4)], t=t)
+    b.vwall(5.0, 0.0, 6.5, gaps=[door(3.2)], t=t, color=kitchen)
+    b.vwall(12.0, 0.0, 6.5, gaps=[door(2.0)], t=t, color=play)
+    b.vwall(5.5, 6.5, h, gaps=[door(9.3)], t=t, color=(0.8, 0.9, 0.7))
+    b.vwall(8.0, 6.5, h, gaps=[door(10.5)], t=t, color=(0.9, 0.8, 0.6))
     b.vwall(12.5, 6.5, h, t=t, color=(0.75, 0.75, 0.95))
     # kitchen (x 0-5, y 0-6.5)
     b.box("counter", 0.3, 3.2, 0.6, 4.0, 0.9, (0.55, 0.4, 0.3))
@@ -231,7 +237,7 @@ def house(seed: int = 0) -> Layout:
     # bedroom 3 (x 12.5-17)
     b.box("bed", 16.0, 10.4, 2.0, 1.6, 0.5, (0.95, 0.85, 0.6))
     b.box("wardrobe", 13.1, h - 0.8, 0.6, 1.2, 2.0, (0.55, 0.35, 0.25))
-    b.cyl("chair", 14.0 + b.jitter(0.2), 8.0, 0.25, 0.8, (0.3, 0.3, 0.6))
+    b.cyl("chair", 13.3 + b.jitter(0.1), 8.4, 0.25, 0.8, (0.3, 0.3, 0.6))
     return b.layout("house", bounds,
                     [(8.5, 3.2, 0.0), (2.5, 3.2, 0.0), (14.5, 1.5, np.pi / 2),
                      (6.75, 9.0, np.pi / 2), (3.0, 8.2, 0.0)], 175.0)
@@ -282,20 +288,22 @@ def aisle_warehouse(seed: int = 0) -> Layout:
     b = _Builder(seed)
     w, h = 19.2, 12.0
     bounds = b.enclosure(w, h, SIDE_COLORS)
-    for y, col in ((1.5, (0.2, 0.35, 0.75)), (5.0, (0.75, 0.3, 0.2)), (8.5, (0.2, 0.6, 0.4))):
-        b.box("rack", 7.5, y, 12.0, 1.0, 2.2, col)
-    for _ in range(4):
-        b.box("pallet", 15.0 + b.rng.uniform(-2.0, 2.5), b.rng.uniform(1.5, 10.5),
+    # rows at x 1.6-13.6 and y 1.6-2.6, 4.9-5.9, 8.2-9.2: aisles, side strips and the
+    # passages at the row ends are all >= 1.6 m wide
+    for y, col in ((2.1, (0.2, 0.35, 0.75)), (5.4, (0.75, 0.3, 0.2)), (8.7, (0.2, 0.6, 0.4))):
+        b.box("rack", 7.6, y, 12.0, 1.0, 2.2, col)
+    for _ in range(4):  # against the east wall, clear of the pillars
+        b.box("pallet", 18.5 + b.jitter(0.1), b.rng.uniform(1.5, 10.5),
               1.0, 1.0, 0.9, PALLET)
-    for x, y in ((13.0, 4.0), (13.0, 8.0)):
+    for x, y in ((15.5, 4.0), (15.5, 8.0)):
         b.cyl("pillar", x, y, 0.2, 2.5, (0.5, 0.5, 0.55))
     return b.layout("aisle_warehouse", bounds,
-                    [(16.0, 6.0, np.pi), (7.5, 3.25, 0.0), (7.5, 6.75, np.pi), (0.8, 10.5, 0.0)],
+                    [(14.5, 6.0, np.pi), (7.5, 3.75, 0.0), (7.5, 7.05, np.pi), (0.8, 10.5, 0.0)],
                     185.0)
 
 
 def random_rooms(seed: int = 0, n_x: int = 3, n_y: int = 2, size=(3.0, 6.0),
-                 door: float = 1.0, furniture: int = 2) -> Layout:
+                 door: float = OPENING, furniture: int = 2) -> Layout:
     """A grid of rooms with random sizes, doorless openings forming a connected plan."""
     b = _Builder(seed)
     rng = b.rng
