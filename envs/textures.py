@@ -350,7 +350,7 @@ def box_mesh(sx: float, sy: float, sz: float):
     return verts, idx, uvs, nrm
 
 
-def cylinder_mesh(radius: float, height: float, segments: int = 16):
+def cylinder_mesh(radius: float, height: float, segments: int = 12):
     """Side of a cylinder (u around, v up) and two caps, centred at the origin."""
     hz = height / 2
     verts, idx, uvs, nrm = [], [], [], []
