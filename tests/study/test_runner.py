@@ -1,0 +1,69 @@
+"""Study runner: atomic per-run files, resume, executors give the same per-run results."""
+
+import json
+
+import pytest
+
+from cogmap.study import main, run_study
+from cogmap.study.config import run_specs, study_plan
+from cogmap.study.runner import load_runs
+from cogmap.study.runs import strip_timings
+
+
+def _body(table: str) -> str:
+    """The table without the header line that reports wall-clock time."""
+    return table[table.index("| "):]
+
+
+def _results(study_dir):
+    return {k: strip_timings(v["result"]) for k, v in load_runs(study_dir).items()}
+
+
+def test_specs_are_unique_and_cover_the_plan():
+    plan = study_plan("drift", "reduced")
+    specs = run_specs(plan)
+    assert len({s["key"] for s in specs}) == len(specs) == len(plan["envs"]) * len(plan["methods"]) * len(
+        plan["seeds"]) * len(plan["params"]["levels"])
+    with pytest.raises(ValueError):
+        study_plan("nope")
+
+
+def test_resumed_study_gives_the_same_table_as_an_uninterrupted_one(tmp_path):
+    kw = dict(scale="tiny", methods=["aimapp", "frontier", "random"], progress=False)
+    whole = run_study("exploration", tmp_path / "whole", **kw)
+    assert whole["complete"] and whole["runs"] == 6
+    part = run_study("exploration", tmp_path / "part", limit=2, **kw)  # "interrupted" after two runs
+    assert not part["complete"] and part["runs"] == 2
+    runs_dir = tmp_path / "part" / "exploration" / "runs"
+    first = sorted(runs_dir.glob("*.json"))[0]
+    stamp = first.stat().st_mtime_ns
+    resumed = run_study("exploration", tmp_path / "part", **kw)
+    assert resumed["complete"]
+    assert first.stat().st_mtime_ns == stamp, "a finished run must not be redone"
+    assert _body(resumed["table"]) == _body(whole["table"])
+    # lose one result file: only that run is redone, the table is unchanged
+    first.unlink()
+    again = run_study("exploration", tmp_path / "part", **kw)
+    assert _body(again["table"]) == _body(whole["table"])
+    assert _results(tmp_path / "part" / "exploration") == _results(tmp_path / "whole" / "exploration")
+    meta = json.loads((tmp_path / "part" / "exploration" / "study.json").read_text())
+    assert meta["complete"] and len(meta["sessions"]) == 3 and meta["versions"]["numpy"]
+    for name in ("table.md", "table.csv", "runs.csv", "coverage_curves.png", "coverage_efficiency.png"):
+        assert (tmp_path / "part" / "exploration" / name).exists()
+    assert not list(runs_dir.glob(".*.tmp"))
+
+
+def test_ray_executor_matches_the_local_one(tmp_path):
+    pytest.importorskip("ray")
+    kw = dict(scale="tiny", seeds=[0, 1], methods=["aimapp", "frontier"], progress=False, report=False)
+    run_study("exploration", tmp_path / "local", workers=1, **kw)
+    run_study("exploration", tmp_path / "ray", workers=2, executor="ray", **kw)
+    local, ray_ = _results(tmp_path / "local" / "exploration"), _results(tmp_path / "ray" / "exploration")
+    assert len(local) == 4 and local == ray_
+
+
+def test_cli_entry_point(tmp_path, capsys):
+    code = main(["goals", "--scale", "tiny", "--seeds", "0", "--out", str(tmp_path), "--quiet"])
+    assert code == 0
+    out = capsys.readouterr().out
+    assert "Executed vs. A*" in out
