@@ -41,6 +41,16 @@ def _gray(image: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(img, dtype=np.float32)
 
 
+THUMB = (8, 32)  # thumbnail (rows, cols) used to shortlist candidates
+
+
+def _thumb(x: np.ndarray) -> np.ndarray:
+    """Zero-mean, unit-norm grey thumbnail: its dot products are normalised correlations."""
+    t = _cv2().resize(x, (THUMB[1], THUMB[0]), interpolation=_cv2().INTER_AREA).ravel()
+    t = t - t.mean()
+    return (t / max(float(np.linalg.norm(t)), 1e-6)).astype(np.float32)
+
+
 def _blur(x: np.ndarray) -> np.ndarray:
     return _cv2().GaussianBlur(x, (11, 11), 1.5, borderType=4)  # BORDER_REFLECT_101
 
@@ -57,60 +67,93 @@ def ssim(a: np.ndarray, b: np.ndarray) -> float:
 
 
 class SSIMEncoder:
-    """Match panoramas by SSIM; unmatched panoramas become new observation ids."""
+    """Match panoramas by SSIM; unmatched panoramas become new observation ids.
 
-    def __init__(self, threshold: float = 0.65):
+    Stored images and their local statistics live in arrays ``(capacity, H, W)`` that double
+    when full. A query first shortlists the stored images whose grey thumbnails correlate best
+    with it, then computes SSIM against those in channel-stacked batches (one blur of the cross
+    products per batch of up to 128 images).
+    """
+
+    def __init__(self, threshold: float = 0.65, shortlist: int | None = 24):
         self.threshold = threshold
+        self.shortlist = shortlist  # SSIM only the best few by thumbnail correlation (None: all)
         self.images: list[np.ndarray] = []
-        self._x: list[np.ndarray] = []  # cached grey images and their local statistics
-        self._mu: list[np.ndarray] = []
-        self._var: list[np.ndarray] = []
+        self._x = self._mu = self._mu2c1 = self._varc2 = None  # (capacity, H, W) float32
+        self._thumbs = np.zeros((0, THUMB[0] * THUMB[1]), dtype=np.float32)
         self.last_scores = np.zeros(0)
 
     def __len__(self) -> int:
         return len(self.images)
 
+    def _reserve(self, shape: tuple[int, int]) -> None:
+        n = len(self.images)
+        if self._x is not None and n < self._x.shape[0]:
+            return
+        cap = max(8, 2 * n)
+        for name in ("_x", "_mu", "_mu2c1", "_varc2"):
+            new = np.zeros((cap,) + shape, dtype=np.float32)
+            old = getattr(self, name)
+            if old is not None:
+                new[:n] = old[:n]
+            setattr(self, name, new)
+
     def add(self, image: np.ndarray) -> int:
         """Store ``image`` as a new observation; returns its id."""
         x = _gray(image)
+        if self.images and x.shape != self._x.shape[1:]:
+            raise ValueError(f"image of shape {x.shape} does not match stored {self._x.shape[1:]}")
+        self._reserve(x.shape)
+        k = len(self.images)
         mu = _blur(x)
+        self._x[k] = x
+        self._mu[k] = mu
+        self._mu2c1[k] = mu * mu + C1
+        self._varc2[k] = _blur(x * x) - mu * mu + C2
+        self._thumbs = np.vstack([self._thumbs, _thumb(x)])
         self.images.append(np.asarray(image).copy())
-        self._x.append(x)
-        self._mu.append(mu)
-        self._var.append(_blur(x * x) - mu * mu)
-        return len(self.images) - 1
+        return k
 
-    def scores(self, image: np.ndarray) -> np.ndarray:
-        """SSIM of ``image`` against every stored image."""
-        if not self.images:
+    def scores(self, image: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
+        """SSIM of ``image`` against the stored images ``ids`` (default: all)."""
+        n = len(self.images)
+        if n == 0:
             return np.zeros(0)
         x = _gray(image)
-        if x.shape != self._x[0].shape:
-            raise ValueError(f"image of shape {x.shape} does not match stored {self._x[0].shape}")
+        if x.shape != self._x.shape[1:]:
+            raise ValueError(f"image of shape {x.shape} does not match stored {self._x.shape[1:]}")
         mx = _blur(x)
         vx = _blur(x * x) - mx * mx
-        out = np.empty(len(self.images))
-        for start in range(0, len(self.images), BATCH):
-            ys = np.stack(self._x[start : start + BATCH], axis=-1)
-            mys = np.stack(self._mu[start : start + BATCH], axis=-1)
-            vys = np.stack(self._var[start : start + BATCH], axis=-1)
-            cxy = _blur(np.ascontiguousarray(x[..., None] * ys))
-            if cxy.ndim == 2:
-                cxy = cxy[..., None]
-            cxy = cxy - mx[..., None] * mys
-            num = (2 * mx[..., None] * mys + C1) * (2 * cxy + C2)
-            den = (mx[..., None] ** 2 + mys**2 + C1) * (vx[..., None] + vys + C2)
-            out[start : start + ys.shape[-1]] = (num / den).mean(axis=(0, 1))
+        ids = np.arange(n) if ids is None else np.asarray(ids, dtype=int)
+        out = np.empty(ids.size)
+        for a in range(0, ids.size, BATCH):
+            sel = ids[a : a + BATCH]
+            prod = (x[None] * self._x[sel]).transpose(1, 2, 0)  # (H, W, k) for the channel-wise blur
+            cxy = np.ascontiguousarray(_blur(np.ascontiguousarray(prod)).reshape(prod.shape).transpose(2, 0, 1))
+            mxy = mx[None] * self._mu[sel]
+            cxy -= mxy  # local covariance
+            num = (2 * mxy + C1) * (2 * cxy + C2)
+            den = ((mx * mx)[None] + self._mu2c1[sel]) * (vx[None] + self._varc2[sel])
+            out[a : a + sel.size] = (num / den).mean(axis=(1, 2))
         return out
+
+    def candidates(self, image: np.ndarray) -> np.ndarray:
+        """Stored ids worth an SSIM: all, or the ``shortlist`` best by thumbnail correlation."""
+        n = len(self.images)
+        if self.shortlist is None or n <= self.shortlist:
+            return np.arange(n)
+        corr = self._thumbs[:n] @ _thumb(_gray(image))
+        return np.sort(np.argpartition(-corr, self.shortlist)[: self.shortlist])
 
     def match(self, image: np.ndarray) -> tuple[int, float]:
         """Best stored id and its score (-1, 0.0 when nothing is stored)."""
-        s = self.scores(image)
+        ids = self.candidates(image)
+        s = self.scores(image, ids)
         self.last_scores = s
         if s.size == 0:
             return -1, 0.0
         best = int(np.argmax(s))
-        return best, float(s[best])
+        return int(ids[best]), float(s[best])
 
     def __call__(self, image: np.ndarray) -> tuple[int, bool]:
         best, score = self.match(image)

@@ -90,3 +90,20 @@ def test_confidence_scores_do_not_depend_on_map_size():
     assert second.lost(4.0) and not second.confident
     calm = assess(believed, believed, np.array([0.9, 0.3]), 4.0, evidence=3.0, slack=1.0)
     assert calm.lost_evidence < 3.0  # expected observations drain the statistic
+
+
+def test_shortlist_match_agrees_with_exhaustive_search():
+    imgs = panoramas(80, seed=5)
+    rng = np.random.default_rng(6)
+    full, quick = SSIMEncoder(shortlist=None), SSIMEncoder(shortlist=8)
+    for img in imgs[:60]:
+        full.add(img)
+        quick.add(img)
+    for i in list(range(0, 60, 6)) + list(range(60, 80, 2)):  # stored places seen again, and new places
+        query = np.clip(imgs[i].astype(int) + rng.integers(-6, 7, imgs[i].shape), 0, 255).astype(np.uint8)
+        (b1, s1), (b2, s2) = full.match(query), quick.match(query)
+        if s1 >= full.threshold:  # recognised: the shortlist finds the same stored image
+            assert b1 == b2 and s1 == pytest.approx(s2, abs=1e-6)
+        else:  # new place: new for both
+            assert s2 < quick.threshold
+        assert (s1 >= full.threshold) == (i < 60)
