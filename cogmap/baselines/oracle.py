@@ -60,6 +60,7 @@ class OracleTour:
         self.ready = False
         self.target: int | None = None
         self.path: np.ndarray | None = None
+        self.visited: set[int] = set()  # viewpoints stood on: whatever they still miss is not visible
 
     def _prepare(self, sim) -> None:
         cfg, grid = self.cfg, sim.grid
@@ -94,6 +95,7 @@ class OracleTour:
         dist, pred = shortest_paths(self.blocked, start)
         d = dist[self.vp_cells[:, 0], self.vp_cells[:, 1]] * res * f
         ok = (gains >= cfg.min_gain) & np.isfinite(d)
+        ok[list(self.visited)] = False
         if not ok.any():
             return False
         score = np.where(ok, gains / (d + cfg.detour_offset), -np.inf)
@@ -111,7 +113,10 @@ class OracleTour:
             self._prepare(sim)
         pos = sim.true_pose()[:2]
         seen = self._seen(sim)
-        if (self.target is None or moved is False or np.hypot(*(pos - self.vp_xy[self.target])) < 0.1
+        arrived = self.target is not None and np.hypot(*(pos - self.vp_xy[self.target])) < 0.1
+        if arrived or (self.target is not None and moved is False):
+            self.visited.add(self.target)
+        if (self.target is None or arrived or moved is False
                 or np.count_nonzero(~seen[self.vp_visible[self.target]]) * sim.grid.resolution**2 < cfg.min_gain):
             if not self._choose(sim):
                 return None

@@ -49,6 +49,16 @@ def _noise(spec):
     return OdometryNoise(**DRIFT_LEVELS[level]) if level else None
 
 
+def study_sim(env: str, cfg, seed: int, noise=None):
+    """A simulator whose start is ``layout.starts[seed % n]``: consecutive seeds start from
+    different places (the paper starts every trial from a different position)."""
+    from cogmap.explore import make_sim
+
+    sim = make_sim(env, cfg, seed, noise)
+    sim.reset(seed, start=seed % len(sim.layout.starts))
+    return sim
+
+
 def _curve(ep, points: int = 120) -> dict:
     d, c = np.asarray(ep.distance), np.asarray(ep.coverage)
     idx = np.unique(np.linspace(0, len(d) - 1, min(points, len(d))).round().astype(int))
@@ -59,10 +69,10 @@ def explore_episode(env: str, method: str, seed: int, steps: int, stop_coverage:
     """Run one method in a fresh simulator; returns (sim, episode, agent-or-policy). Caller closes sim."""
     from cogmap.agent.aimapp import AIMAPPAgent
     from cogmap.baselines import FrontierConfig, FrontierExplorer, OracleConfig, OracleTour, RandomWalk, run_policy
-    from cogmap.explore import default_config, make_sim, run_agent
+    from cogmap.explore import default_config, run_agent
 
     cfg = default_config(env)
-    sim = make_sim(env, cfg, seed, noise)
+    sim = study_sim(env, cfg, seed, noise)
     step = cfg.influence_radius
     if method == "aimapp":
         agent = AIMAPPAgent(cfg, seed=seed)
@@ -147,7 +157,7 @@ def _choose_goals(agent, start_state: int, k: int, min_dist: float) -> list[tupl
 
 def run_goals(spec) -> dict:
     """Explore, then from the exploration start (known) pursue stored goal observations."""
-    from cogmap.explore import default_config, make_sim
+    from cogmap.explore import default_config
     from cogmap.goal import pursue
 
     p = spec["params"]
@@ -156,7 +166,7 @@ def run_goals(spec) -> dict:
     sim.close()
     cfg = default_config(spec["env"])
     base = copy.deepcopy(agent)
-    sim = make_sim(spec["env"], cfg, spec["seed"])
+    sim = study_sim(spec["env"], cfg, spec["seed"])
     try:
         start_state = base.localise_at(sim.odometry())
         goals = _choose_goals(base, start_state, p["goals_per_run"], p["min_goal_distance"])
@@ -166,7 +176,7 @@ def run_goals(spec) -> dict:
     for gi, (obs, goal_states) in enumerate(goals):
         ag = copy.deepcopy(base)
         ag.rng = np.random.default_rng([spec["seed"], gi])
-        sim = make_sim(spec["env"], cfg, spec["seed"])
+        sim = study_sim(spec["env"], cfg, spec["seed"])
         try:
             s0 = ag.localise_at(sim.odometry())
             plan_m = graph_plan_length(ag.model.B[0], ag.poses, s0, goal_states, cfg.inductive_threshold)
@@ -186,11 +196,11 @@ def run_obstacle(spec) -> dict:
     """Figure 8: explore, move a box onto a free node the agent knows, track the belief of
     transitions into that node."""
     from cogmap.agent.aimapp import AIMAPPAgent
-    from cogmap.explore import default_config, make_sim, run_agent
+    from cogmap.explore import default_config, run_agent
 
     p = spec["params"]
     cfg = default_config(spec["env"])
-    sim = make_sim(spec["env"], cfg, spec["seed"])
+    sim = study_sim(spec["env"], cfg, spec["seed"])
     try:
         agent = AIMAPPAgent(cfg, seed=spec["seed"])
         trace = []
@@ -261,11 +271,11 @@ def run_scaling(spec) -> dict:
     """Figure 13: time per decision against the number of states; model size against the
     number of stored observations."""
     from cogmap.agent.aimapp import AIMAPPAgent
-    from cogmap.explore import default_config, make_sim, run_agent
+    from cogmap.explore import default_config, run_agent
 
     every = spec["params"]["size_every"]
     cfg = default_config(spec["env"])
-    sim = make_sim(spec["env"], cfg, spec["seed"])
+    sim = study_sim(spec["env"], cfg, spec["seed"])
     try:
         agent = AIMAPPAgent(cfg, seed=spec["seed"])
         sizes = []
