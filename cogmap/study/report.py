@@ -332,6 +332,10 @@ def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
             f"{meta['runs_done']}/{meta['runs_total']} runs, commit `{meta['commit']}`, "
             f"wall clock {meta['wall_s_total']:.0f} s over {len(meta['sessions'])} session(s) "
             f"(sum of run times {meta['run_wall_s_total']:.0f} s).\n\n")
+    codes = sorted({r.get("code") for r in results if r.get("code")})
+    if len(codes) > 1:
+        head += (f"**Warning:** the runs were made with {len(codes)} different versions of the code (source digests "
+                 f"{', '.join(codes)}): the tree changed while the study ran.\n\n")
     text = head + body + "\n"
     (study_dir / "table.md").write_text(text)
     return text

@@ -134,6 +134,7 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
         "sessions": prev.get("sessions", []) + [{"ran": len(todo), "wall_s": round(elapsed, 1), "executor": executor,
                                                  "workers": workers}],
         "run_wall_s_total": round(sum(r.get("wall_s", 0.0) for r in results), 1),
+        "code_digests": sorted({r["code"] for r in results if r.get("code")}),
     }
     meta["wall_s_total"] = round(sum(s["wall_s"] for s in meta["sessions"]), 1)
     write_json_atomic(meta_path, meta)

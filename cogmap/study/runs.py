@@ -299,11 +299,36 @@ RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": 
            "obstacle": run_obstacle, "scaling": run_scaling}
 
 
+_DIGEST: str | None = None
+
+
+def code_digest() -> str:
+    """SHA-256 (16 hex) of every Python source of the installed packages (cogmap, genmodel,
+    inference, planning, envs) as on disk at this process's first run: runs made while someone edits
+    the tree carry different digests, and the report says so."""
+    global _DIGEST
+    if _DIGEST is None:
+        import hashlib
+        import importlib
+
+        h = hashlib.sha256()
+        for name in ("cogmap", "cogmap.genmodel", "cogmap.inference", "cogmap.planning", "cogmap.envs"):
+            root = Path(importlib.import_module(name).__file__).parent
+            files = sorted(root.glob("*.py")) if name != "cogmap" else sorted(root.rglob("*.py"))
+            for f in files:
+                h.update(str(f.relative_to(root)).encode())
+                h.update(f.read_bytes())
+        _DIGEST = h.hexdigest()[:16]
+    return _DIGEST
+
+
 def execute(spec: dict) -> dict:
-    """Run one spec and return ``{"spec": spec, "result": ..., "wall_s": ...}`` (JSON-able)."""
+    """Run one spec and return ``{"spec": spec, "result": ..., "wall_s": ..., "code": digest}`` (JSON-able)."""
+    code = code_digest()  # before the run: the code this process imported
     t0 = time.perf_counter()
     result = RUNNERS[spec["study"]](spec)
-    return _clean({"key": spec["key"], "spec": spec, "result": result, "wall_s": time.perf_counter() - t0})
+    return _clean({"key": spec["key"], "spec": spec, "result": result, "wall_s": time.perf_counter() - t0,
+                   "code": code})
 
 
 def strip_timings(x):
