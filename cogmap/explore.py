@@ -56,11 +56,14 @@ class Episode:
 
 
 def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
-    from cogmap.envs import NavSim, OdometryNoise, SimConfig
+    """The room, with the start pose chosen by the seed (each seed starts somewhere else, as
+    in the paper's protocol, cycling through the layout's start poses)."""
+    from cogmap.envs import NavSim, OdometryNoise, SimConfig, make_layout
 
+    layout = make_layout(layout_name(env))
     sim_cfg = SimConfig(step_length=cfg.influence_radius, obstacle_margin=cfg.obstacle_margin,
                         noise=noise or OdometryNoise())
-    return NavSim(layout_name(env), sim_cfg, seed=seed)
+    return NavSim(layout, sim_cfg, seed=seed, start=seed % len(layout.starts))
 
 
 def sense(sim, moved: bool | None, cfg: AgentConfig) -> Sensed:

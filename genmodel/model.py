@@ -152,13 +152,14 @@ class Model:
         return B[:n, :n, u] @ q
 
     # -- growth ----------------------------------------------------------------------------
-    def add_state(self, factor: str | int = 0, pose=None) -> int:
+    def add_state(self, factor: str | int = 0, pose=None, obs_count: float | None = None) -> int:
         """Add one state to a growable factor; returns its index.
 
-        The new state's likelihood columns are uniform over live outcomes (with ``prior_count``
-        Dirichlet counts), its transitions self-loop with ``prior_count`` counts, the stay
-        control stays the identity, no existing count changes, and every column stays
-        normalised. ``pose`` (x, y) is stored when the model has a pose factor.
+        The new state's likelihood columns are uniform over live outcomes with ``obs_count``
+        Dirichlet counts per outcome (default ``prior_count``), its transitions self-loop with
+        ``prior_count`` counts, the stay control stays the identity, no existing count changes,
+        and every column stays normalised. ``pose`` (x, y) is stored when the model has a pose
+        factor.
         """
         f = self.factor_index(factor)
         if not self.factors[f].growable:
@@ -179,7 +180,7 @@ class Model:
             self.A[m][col][:n_o] = 1.0 / max(1, n_o)
             if self.pA[m] is not None:
                 self.pA[m][col] = 0.0
-                self.pA[m][col][:n_o] = self.prior_count
+                self.pA[m][col][:n_o] = self.prior_count if obs_count is None else obs_count
         B = self.B[f]
         if isinstance(B, SparseTransitions):
             B.succ[s] = s
@@ -201,12 +202,12 @@ class Model:
             self.pose.poses[s] = pose
         return s
 
-    def add_observation(self, modality: str | int = 0) -> int:
+    def add_observation(self, modality: str | int = 0, count: float | None = None) -> int:
         """Add one outcome to a growable modality; returns its index.
 
-        With Dirichlet counts, every live column gains ``prior_count`` for the new outcome and
-        is renormalised from its counts (existing counts unchanged); without counts the new
-        outcome starts with probability 0 everywhere.
+        With Dirichlet counts, every live column gains ``count`` (default ``prior_count``) for
+        the new outcome and is renormalised from its counts (existing counts unchanged); without
+        counts the new outcome starts with probability 0 everywhere.
         """
         m = self.modality_index(modality)
         if not self.modalities[m].growable:
@@ -218,7 +219,7 @@ class Model:
         live = tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
         self.A[m][(o,) + live] = 0.0
         if self.pA[m] is not None:
-            self.pA[m][(o,) + live] = self.prior_count
+            self.pA[m][(o,) + live] = self.prior_count if count is None else count
             counts = self.pA[m][(slice(0, o + 1),) + live]
             self.A[m][(slice(0, o + 1),) + live] = counts / counts.sum(axis=0, keepdims=True)
         self.C[m][o] = 0.0

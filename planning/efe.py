@@ -138,6 +138,10 @@ ALL_TERMS: dict[str, Term] = {
 }
 
 
+#: terms whose value is information: gained once, so not counted again on a revisit (MCTS)
+EPISTEMIC = (state_info_gain, param_info_gain, a_novelty, b_novelty)
+
+
 # -- combinator ------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Objective:
@@ -151,6 +155,19 @@ class Objective:
             if w != 0.0:
                 g -= w * term(ctx)
         return g
+
+    def split(self, ctx) -> tuple[np.ndarray, np.ndarray]:
+        """``(G, G without the epistemic terms)``: the second is the value of a step whose
+        information has already been gained earlier on the same imagined path."""
+        g = np.zeros(ctx.num_candidates)
+        g_known = np.zeros(ctx.num_candidates)
+        for term, w in self.terms:
+            if w != 0.0:
+                v = w * term(ctx)
+                g -= v
+                if term not in EPISTEMIC:
+                    g_known -= v
+        return g, g_known
 
     def breakdown(self, ctx) -> dict[str, np.ndarray]:
         """Weighted contribution of every term to ``G`` (same sign as ``G``)."""

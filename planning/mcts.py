@@ -50,14 +50,22 @@ class MCTSConfig:
     share: str = "state_depth"  # key of visit statistics: "state_depth" or "state"
     backup: str = "min"  # edge value: "min" (best cumulative EFE seen below it) or "mean"
     support_tol: float = 1e-9  # root belief entries below tol * max are dropped (local path)
+    # With ``count_information_once``, epistemic value is counted once per imagined path:
+    # returning to a state (or belief) already visited on the path gains no information again,
+    # so back-and-forth paths cannot accumulate it (an exploring agent would otherwise oscillate
+    # between two informative states). ``discount`` < 1 then prefers information gained sooner.
+    # The defaults are the plain sum of Eq. 5.
+    count_information_once: bool = False
+    discount: float = 1.0
 
 
 class Node:
-    __slots__ = ("actions", "g", "child", "n", "w", "best", "N", "tie", "order", "tried")
+    __slots__ = ("actions", "g", "g_known", "child", "n", "w", "best", "N", "tie", "order", "tried")
 
-    def __init__(self, actions, g, child, tie):
+    def __init__(self, actions, g, child, tie, g_known=None):
         self.actions = actions
         self.g = g
+        self.g_known = g if g_known is None else g_known  # step value when its outcome is already known
         self.child = child
         self.n = np.zeros(len(g))
         self.w = np.zeros(len(g))
@@ -144,14 +152,15 @@ class LocalExpander:
             coll = self.obstacles[acts]
         ctx = LocalStep(self.prep, self.prior_idx, self.prior_p, acts, 0, coll)
         self.expansions += 1
-        return acts, self.objective(ctx), ctx.most_likely().tolist()
+        self.root_key = anchor
+        return (acts, *self.objective.split(ctx), ctx.most_likely().tolist())
 
     def expand(self, s: int):
         hit = self.cache.get(s)
         if hit is None:
             acts = allowed_actions(self.B, s, self.stay, self.cfg.move_threshold)
             ctx = LocalStep(self.prep, (s,), (1.0,), acts, 1, None)
-            hit = (acts, self.objective(ctx), ctx.most_likely().tolist())
+            hit = (acts, *self.objective.split(ctx), ctx.most_likely().tolist())
             self.cache[s] = hit
             self.expansions += 1
         return hit
@@ -183,10 +192,10 @@ class BeliefExpander:
     def _step(self, qs, acts, coll):
         K = len(acts)
         ctx = DenseStep(self.prep, [np.broadcast_to(q, (K, q.size)) for q in qs], acts, 0, coll)
-        g = self.objective(ctx)
+        g, g_known = self.objective.split(ctx)
         kids = [self._key([q[k] for q in ctx.qs]) for k in range(K)]
         self.expansions += 1
-        return acts, g, kids
+        return acts, g, g_known, kids
 
     def root(self):
         acts = self.controls
@@ -198,6 +207,7 @@ class BeliefExpander:
                 if len(free):
                     acts = free
             coll = self.obstacles[acts[:, cf]]
+        self.root_key = self._key(self.root_q)
         return self._step(self.root_q, acts, coll)
 
     def expand(self, key: int):
@@ -210,30 +220,32 @@ class BeliefExpander:
 
 def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> Decision:
     """Run ``cfg.simulations`` simulations of ``cfg.depth`` steps and decide."""
-    acts, g, kids = expander.root()
-    root = Node(acts, g, kids, rng.random(len(g)) * 1e-9)
+    acts, g, g_known, kids = expander.root()
+    root = Node(acts, g, kids, rng.random(len(g)) * 1e-9, g_known)
     nodes: dict = {}
     by_state = cfg.share == "state"
     use_min = cfg.backup == "min"
     for _ in range(cfg.simulations):
         node = root
         path = []
+        seen = {expander.root_key}  # information at a state seen earlier on this path is known
         for d in range(cfg.depth):
             i = node.select(cfg.c, use_min)
-            path.append((node, i))
+            key = node.child[i]
+            path.append((node, i, cfg.count_information_once and key in seen))
+            seen.add(key)
             if d + 1 == cfg.depth:
                 break
-            key = node.child[i]
             nk = key if by_state else (key, d + 1)
             nxt = nodes.get(nk)
             if nxt is None:
-                a2, g2, k2 = expander.expand(key)
-                nxt = Node(a2, g2, k2, rng.random(len(g2)) * 1e-9)
+                a2, g2, gk2, k2 = expander.expand(key)
+                nxt = Node(a2, g2, k2, rng.random(len(g2)) * 1e-9, gk2)
                 nodes[nk] = nxt
             node = nxt
         ret = 0.0
-        for node, i in reversed(path):
-            ret += node.g[i]
+        for node, i, known in reversed(path):
+            ret = (node.g_known[i] if known else node.g[i]) + cfg.discount * ret
             node.n[i] += 1.0
             node.w[i] += ret
             if ret < node.best[i]:

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cogmap.genmodel import Factor, Modality, Model, ModelSpec, PoseSpec, SparseB, compile
+from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseB, compile
 from cogmap.inference import bayes_filter
 from cogmap.inference.learning import Event, learn_observation, learn_transition
 
@@ -72,6 +72,7 @@ def initial_model(cfg: AgentConfig, pose0) -> Model:
         pB={"place": np.full((1, 1, u), cfg.prior_count)},
         pose=PoseSpec("place", np.asarray(pose0, dtype=float)[None, :2], headings, cfg.influence_radius,
                       cfg.influence_radius, cfg.sigma),
+        inductive=InductiveSpec(cfg.inductive_threshold, cfg.inductive_depth, cfg.inductive_weight),
     )
     return compile(spec, prior_count=cfg.prior_count)
 
@@ -174,7 +175,9 @@ class AIMAPPAgent:
         obs, _ = self.encoder(panorama)
         self.last_obs = obs
         while self.model.num_obs[0] <= obs:
-            self.model.add_observation(0)
+            # a column's prior mass stays prior_count however many outcomes exist, so a taught
+            # column keeps its certainty as the vocabulary of views grows
+            self.model.add_observation(0, count=self.cfg.prior_count / (self.model.num_obs[0] + 1))
         return obs, float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
 
     def _infer(self, obs: int, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
@@ -187,7 +190,9 @@ class AIMAPPAgent:
             prior = self._prior(self._outcome)
             q, _ = bayes_filter(self.model, [prior], [{"view": obs, "pose": pose}])
         q = q[0]
-        conf = assess(q, prior, self.model.live_A(0)[obs], cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
+        d2 = np.sum((self.poses - pose) ** 2, axis=1)
+        near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are
+        conf = assess(q, near, self.model.live_A(0)[obs], cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
         return q, conf
 
     def _update(self, q: np.ndarray, conf: Confidence, obs: int, sensed: Sensed, pose: np.ndarray,
@@ -300,32 +305,40 @@ class AIMAPPAgent:
         origin = self.poses[state].copy()
         neighbours = self._neighbours_by_heading(state)
         created = 0
+        B = m.B[0]
         for h in range(cfg.num_headings):
             rev = reverse_heading(h, cfg.num_headings)
             n = int(neighbours[h])
-            if n >= 0:
-                event = Event.PREDICTED_IMPOSSIBLE if obstacles[h] else Event.PREDICTED_POSSIBLE
-                learn_transition(m, 0, state, h, n, event, reverse_control=rev, rates=cfg.learning)
+            if obstacles[h]:  # blocked: every state this move is believed to reach is predicted out of reach
+                believed = {int(t) for t, p in zip(B.succ[state, h], B.prob[state, h], strict=True) if p > 0}
+                for t in sorted((believed | {n}) - {state, -1}):
+                    learn_transition(m, 0, state, h, t, Event.PREDICTED_IMPOSSIBLE, reverse_control=rev,
+                                     rates=cfg.learning)
                 continue
-            if obstacles[h] or created >= cfg.lookahead_nodes:
+            if n >= 0:
+                learn_transition(m, 0, state, h, n, Event.PREDICTED_POSSIBLE, reverse_control=rev, rates=cfg.learning)
+                continue
+            if created >= cfg.lookahead_nodes:
                 continue
             p_star = origin + cfg.influence_radius * direction(h, cfg.num_headings)
             d_near = float(np.min(np.hypot(*(self.poses - p_star).T)))
             if expansion_free_energies(np.array([d_near]), radius, cfg.sigma)[0] < 0:  # Eq. (7)
-                new = m.add_state(0, pose=p_star)
+                new = m.add_state(0, pose=p_star, obs_count=cfg.prior_count / m.num_obs[0])
                 created += 1
                 learn_transition(m, 0, state, h, new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
                                  rates=cfg.learning)
         return created
 
     def _waypoint(self, state: int, action: int) -> tuple[int, np.ndarray]:
-        """Where an action leads: the believed successor node, or one step in its heading."""
+        """Where an action leads: its most probable successor other than staying (as the planner
+        saw it), or, for a direction with no state yet, one step along its heading."""
         cfg = self.cfg
         if action == cfg.stay:
             return state, self.poses[state].copy()
         B = self.model.B[0]
-        k = int(np.argmax(B.prob[state, action]))
-        target = int(B.succ[state, action, k])
-        if target != state and B.prob[state, action, k] > 0.5:
+        prob = np.where(B.succ[state, action] != state, B.prob[state, action], 0.0)
+        k = int(np.argmax(prob))
+        if prob[k] > 0:
+            target = int(B.succ[state, action, k])
             return target, self.poses[target].copy()
         return state, self.poses[state] + cfg.influence_radius * direction(action, cfg.num_headings)

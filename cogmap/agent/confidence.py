@@ -6,9 +6,12 @@ neither of which depends on how many states exist:
 
 * ``dominance``: log-odds of the most likely state against the runner-up;
 * ``conflict``: how much better the current observation would be explained by the state that
-  explains it best than by the predicted belief, ``ln max_s A[o, s] - ln sum_s q(s) A[o, s]``.
-  It is large when a familiar observation turns up where the agent does not expect it
-  (kidnapping, large drift), and near zero for new observations or expected ones.
+  explains it best anywhere than by the best state around where the agent believes it is,
+  ``ln max_s A[o, s] - ln max_s w(s) A[o, s]``, with ``w`` a kernel of one influence radius
+  around the believed pose (1 at the nearest state; so a view that also belongs to a
+  neighbouring node, perceptual aliasing, is not a conflict). It is large when a familiar observation turns up far from where
+  the agent believes it is (kidnapping, large drift), and near zero for new observations or
+  expected ones.
 
 Conflict is a log-likelihood ratio ("the observation comes from somewhere else" against "it
 comes from where I believe I am"), so the agent declares itself *lost* with a CUSUM test on it:
@@ -44,11 +47,12 @@ def dominance(q: np.ndarray) -> float:
     return float(np.log(max(top2[1], TINY)) - np.log(max(top2[0], TINY)))
 
 
-def conflict(A_row: np.ndarray, q_prior: np.ndarray) -> float:
-    """``A_row[s] = A[o, s]`` for the observed outcome over live states."""
+def conflict(A_row: np.ndarray, nearby: np.ndarray) -> float:
+    """``A_row[s] = A[o, s]`` for the observed outcome; ``nearby[s]`` in [0, 1] weights how
+    plausible state ``s`` is given the believed pose."""
     A_row = np.asarray(A_row, dtype=float)
-    predicted = float(A_row @ np.asarray(q_prior, dtype=float))
-    return float(np.log(max(A_row.max(), TINY)) - np.log(max(predicted, TINY)))
+    local = float(np.max(A_row * np.asarray(nearby, dtype=float)))
+    return float(np.log(max(A_row.max(), TINY)) - np.log(max(local, TINY)))
 
 
 def cusum(previous: float, conflict_value: float, slack: float = 1.0) -> float:
@@ -56,10 +60,11 @@ def cusum(previous: float, conflict_value: float, slack: float = 1.0) -> float:
     return max(0.0, previous + conflict_value - slack)
 
 
-def assess(q_post: np.ndarray, q_prior: np.ndarray, A_row: np.ndarray | None, threshold: float,
+def assess(q_post: np.ndarray, nearby: np.ndarray, A_row: np.ndarray | None, threshold: float,
            evidence: float = 0.0, slack: float = 1.0) -> Confidence:
-    """Scores for one step; ``evidence`` is the CUSUM statistic before this step."""
+    """Scores for one step; ``nearby`` weights the states the believed pose allows (see
+    :func:`conflict`), ``evidence`` is the CUSUM statistic before this step."""
     dom = dominance(q_post)
-    con = 0.0 if A_row is None else conflict(A_row, q_prior)
+    con = 0.0 if A_row is None else conflict(A_row, nearby)
     lost = cusum(evidence, con, slack)
     return Confidence(dom, con, lost, dom >= threshold and lost < threshold)

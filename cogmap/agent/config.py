@@ -17,6 +17,8 @@ class AgentConfig:
     ssim_threshold: float = 0.65  # place recognition (Table 6)
     mcts_depth: int = 10  # Appendix A.3
     mcts_simulations: int = 30
+    mcts_count_information_once: bool = False  # Eq. 5 sums every step's EFE (see MCTSConfig)
+    mcts_discount: float = 1.0
     z_threshold: float = 4.0  # confidence test (A.1.2), in nats of log-odds
     goal_weight: float = 10.0  # preference weight on the goal observation (section 4.4)
     gamma: float = 8.0  # policy precision (Eq. 4)
@@ -24,8 +26,10 @@ class AgentConfig:
     obstacle_margin: float = 0.1  # a direction is blocked when the sector's range < step + margin
     min_move_probability: float = 0.1  # a move is planned only if it is believed to leave the state
     inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
+    inductive_depth: int = 60  # steps over which H propagates goal value back (beyond the MCTS depth)
+    inductive_weight: float = 1.0
     collision_preference: float = -6.0  # log-preference of a collision outcome
-    prior_count: float = 0.1  # Dirichlet count of each outcome in a new column
+    prior_count: float = 0.1  # Dirichlet mass of a new column (A_o: spread over the outcomes; B_s: on staying)
     obs_learning_rate: float = 4.0  # counts added when an observation is tied to a state
     relocalise_ssim: float = 0.9  # a recognised view this similar re-localises the metric pose
     lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)

@@ -78,7 +78,7 @@ def test_confidence_scores_do_not_depend_on_map_size():
     q = np.array([0.999, 0.001])
     assert assess(q, q, None, 4.0).confident  # ln(999) = 6.9 nats
     assert not assess(np.array([0.9, 0.1]), q, None, 4.0).confident
-    # a familiar observation strongly tied to state 1 seen while believing state 0: conflict
+    # a familiar observation strongly tied to state 1 seen where the pose allows only state 0: conflict
     A_row = np.array([0.01, 0.95])
     assert conflict(A_row, np.array([0.999, 0.001])) > 4
     assert conflict(A_row, np.array([0.001, 0.999])) < 0.1

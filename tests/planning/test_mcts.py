@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import networkx as nx
 import numpy as np
 import pytest
@@ -29,14 +31,17 @@ def test_ucb_selection_uses_values():
 
 
 class _ToyExpander:
-    """Root actions 0 and 1 have equal immediate EFE; only action 0 leads on to good values."""
+    """Root actions 0 and 1 have equal immediate EFE; only action 0 leads on to good values.
+    Expanders return (actions, G, G without epistemic terms, child keys)."""
+
+    root_key = "root"
 
     def root(self):
-        return np.array([0, 1]), np.zeros(2), ["good", "bad"]
+        return np.array([0, 1]), np.zeros(2), np.zeros(2), ["good", "bad"]
 
     def expand(self, key):
         g = np.array([-1.0, -1.0]) if key == "good" else np.array([0.0, 0.0])
-        return np.array([0, 1]), g, [key, key]
+        return np.array([0, 1]), g, np.zeros(2), [key, key]
 
 
 def test_visits_follow_deeper_values():
@@ -44,6 +49,44 @@ def test_visits_follow_deeper_values():
     assert d.action == 0
     assert d.visits[0] > 2 * d.visits[1]  # would be an even split if selection ignored values
     np.testing.assert_allclose(d.Q, [-3.0, 0.0])
+
+
+class _PingPong:
+    """Two neighbouring states A and B worth 1 nat of information each; the other way from the
+    root, a corridor C1, C2 leads to C3 worth 3 nats (then a dead end D). Counting information
+    on every visit makes bouncing between A and B the best plan (4 nats in 4 steps); counting it
+    once per path does not (2 nats), so the far, richer C3 wins."""
+
+    root_key = "root"
+    values = {"A": 1.0, "B": 1.0, "C1": 0.0, "C2": 0.0, "C3": 3.0, "D": 0.0, "root": 0.0}
+    links = {"root": ["A", "C1"], "A": ["B", "root"], "B": ["A", "root"], "C1": ["C2", "root"],
+             "C2": ["C3", "C1"], "C3": ["D", "C2"], "D": ["D", "C3"]}
+
+    def _step(self, key):
+        nxt = self.links[key]
+        return np.array([0, 1]), -np.array([self.values[k] for k in nxt]), np.zeros(2), nxt
+
+    def root(self):
+        return self._step("root")
+
+    def expand(self, key):
+        return self._step(key)
+
+
+def test_information_counted_once_per_path_stops_ping_pong():
+    cfg = MCTSConfig(depth=4, simulations=300)
+    plain = search(_PingPong(), cfg, np.random.default_rng(0))
+    once = search(_PingPong(), replace(cfg, count_information_once=True), np.random.default_rng(0))
+    assert plain.action == 0 and plain.Q[0] == pytest.approx(-4.0)  # A, B, A, B
+    assert once.action == 1 and once.Q[1] == pytest.approx(-3.0)  # C1, C2, C3, D
+    assert once.Q[0] == pytest.approx(-2.0)  # A and B once each
+
+
+def test_discount_prefers_information_sooner():
+    cfg = MCTSConfig(depth=4, simulations=300, count_information_once=True, discount=0.5)
+    d = search(_PingPong(), cfg, np.random.default_rng(0))
+    assert d.action == 0  # 1 + 0.5 * 1 = 1.5 now beats 0.25 * 3 = 0.75 later
+    np.testing.assert_allclose(d.Q, [-1.5, -0.75])
 
 
 @pytest.mark.parametrize("seed", range(5))
