@@ -9,9 +9,9 @@ neither of which depends on how many states exist:
   explains it best anywhere than by the best state around where the agent believes it is,
   ``ln max_s A[o, s] - ln max_s w(s) A[o, s]``, with ``w`` a kernel of one influence radius
   around the believed pose (1 at the nearest state; so a view that also belongs to a
-  neighbouring node, perceptual aliasing, is not a conflict). It is large when a familiar observation turns up far from where
-  the agent believes it is (kidnapping, large drift), and near zero for new observations or
-  expected ones.
+  neighbouring node, perceptual aliasing, is not a conflict). It is large when a familiar
+  observation turns up far from where the agent believes it is (kidnapping, large drift), and
+  near zero for new observations or expected ones.
 
 Conflict is a log-likelihood ratio ("the observation comes from somewhere else" against "it
 comes from where I believe I am"), so the agent declares itself *lost* with a CUSUM test on it:
