@@ -1,4 +1,5 @@
-"""Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``."""
+"""Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
+``cogmap reproduce``."""
 
 from __future__ import annotations
 
@@ -43,6 +44,12 @@ def _compare(args) -> int:
     return 0
 
 
+def _reproduce(args) -> int:
+    from .study.runner import run_from_args
+
+    return run_from_args(args)
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(prog="cogmap", description="Active-inference navigation toolkit")
     sub = p.add_subparsers(dest="command", required=True)
@@ -71,6 +78,12 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--steps", type=int, default=30)
     c.add_argument("--seed", type=int, default=0)
     c.set_defaults(func=_compare)
+
+    from .study.runner import build_parser as study_arguments
+
+    r = sub.add_parser("reproduce", help="re-run a study of the paper (tables and figures beside the published ones)")
+    study_arguments(r)
+    r.set_defaults(func=_reproduce)
     return p
 
 

@@ -8,7 +8,7 @@ import subprocess
 from importlib import metadata
 from pathlib import Path
 
-PACKAGES = ("cogmap", "numpy", "scipy", "jax", "networkx", "pybullet", "opencv-python-headless", "gymnasium")
+PACKAGES = ("cogmap", "numpy", "scipy", "jax", "networkx", "pybullet", "opencv-python-headless", "gymnasium", "ray")
 
 
 def versions() -> dict[str, str]:
