@@ -68,14 +68,16 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
 
 def sense(sim, moved: bool | None, cfg: AgentConfig) -> Sensed:
     """Panorama, odometry and the corridor obstacle signal (odometry frame) from the robot."""
-    from cogmap.agent.sensing import corridor_obstacles
+    from cogmap.agent.sensing import corridor_obstacles, scan_points
 
     ranges, odom = sim.lidar(), sim.odometry()
-    obstacles = None
+    obstacles = points = None
     if ranges is not None and odom is not None:
-        obstacles = corridor_obstacles(ranges, sim.lidar_angles() + odom[2], cfg.num_headings, cfg.influence_radius,
+        angles = sim.lidar_angles() + odom[2]  # beams in the odometry frame
+        obstacles = corridor_obstacles(ranges, angles, cfg.num_headings, cfg.influence_radius,
                                        cfg.robot_radius + cfg.obstacle_margin, sim.config.lidar_range)
-    return Sensed(sim.panorama(), obstacles, odom, moved)
+        points = scan_points(ranges, angles, sim.config.lidar_range)
+    return Sensed(sim.panorama(), obstacles, odom, moved, points)
 
 
 def act(sim, agent: AIMAPPAgent, d: Decision) -> bool:

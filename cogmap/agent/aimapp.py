@@ -32,6 +32,7 @@ from .confidence import Confidence, assess
 from .config import AgentConfig
 from .encoder import Encoder, SSIMEncoder
 from .mapping import direction, expansion_free_energies, reverse_heading
+from .sensing import blocked
 
 
 @dataclass
@@ -42,6 +43,7 @@ class Sensed:
     obstacles: np.ndarray | None  # one bool per heading: obstacle within reach
     odometry: np.ndarray | None  # (x, y, yaw) in the odometry frame
     moved: bool | None = None  # outcome of the last motion command (None: no command)
+    scan: np.ndarray | None = None  # optional LiDAR returns relative to the robot (odometry frame, (n, 2))
 
 
 @dataclass
@@ -231,7 +233,8 @@ class AIMAPPAgent:
             waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
             return Decision(action, waypoint - self.offset, state, state, "relocalise", conf, expanded)
         mode = "goal" if self.goal_obs is not None else "explore"
-        action, efe = planner.decide(self, state, sensed.obstacles, mode)
+        flags = self._move_obstacles(state, sensed.obstacles, sensed.scan, pose)
+        action, efe = planner.decide(self, state, flags, mode)
         target, waypoint = self._waypoint(state, action)
         return Decision(action, waypoint - self.offset, state, target, mode, conf, expanded, efe)
 
@@ -279,7 +282,7 @@ class AIMAPPAgent:
                              reverse_control=self._reverse(last.action), rates=cfg.learning)
         if not arrived:
             return 0
-        return self._expand(state, np.asarray(sensed.obstacles, dtype=bool))
+        return self._expand(state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan, pose)
 
     def _neighbours_by_heading(self, state: int) -> np.ndarray:
         """For each heading, the nearest state lying in that direction (bearing within half a
@@ -297,7 +300,30 @@ class AIMAPPAgent:
                 out[h] = int(np.flatnonzero(ok)[np.argmin(dist[ok])])
         return out
 
-    def _expand(self, state: int, obstacles: np.ndarray) -> int:
+    def _path_blocked(self, heading: int, target: int, obstacles: np.ndarray, scan: np.ndarray | None,
+                      pose: np.ndarray) -> bool:
+        """Would the move toward ``target`` collide? With a scan, its corridor is checked along
+        the actual bearing and length from ``pose`` to the target (what the robot will drive);
+        otherwise the heading's flag is used."""
+        if scan is None:
+            return bool(obstacles[heading])
+        cfg = self.cfg
+        return bool(blocked(scan, self.poses[target] - pose, cfg.robot_radius + cfg.obstacle_margin)[0])
+
+    def _move_obstacles(self, state: int, obstacles: np.ndarray, scan: np.ndarray | None,
+                        pose: np.ndarray) -> np.ndarray:
+        """Collision flag per heading for the move the agent would make: toward the believed
+        successor when there is one, else straight along the heading."""
+        flags = np.asarray(obstacles, dtype=bool).copy()
+        if scan is None:
+            return flags
+        for h in range(self.cfg.num_headings):
+            target, _ = self._waypoint(state, h)
+            if target != state:
+                flags[h] = self._path_blocked(h, target, obstacles, scan, pose)
+        return flags
+
+    def _expand(self, state: int, obstacles: np.ndarray, scan: np.ndarray | None, pose: np.ndarray) -> int:
         """Predicted transitions from the obstacle signal, and Eq. (7) map expansion in free
         directions where no state lies yet."""
         m, cfg = self.model, self.cfg
@@ -309,14 +335,14 @@ class AIMAPPAgent:
         for h in range(cfg.num_headings):
             rev = reverse_heading(h, cfg.num_headings)
             n = int(neighbours[h])
-            if obstacles[h]:  # blocked: every state this move is believed to reach is predicted out of reach
-                believed = {int(t) for t, p in zip(B.succ[state, h], B.prob[state, h], strict=True) if p > 0}
-                for t in sorted((believed | {n}) - {state, -1}):
-                    learn_transition(m, 0, state, h, t, Event.PREDICTED_IMPOSSIBLE, reverse_control=rev,
-                                     rates=cfg.learning)
-                continue
-            if n >= 0:
-                learn_transition(m, 0, state, h, n, Event.PREDICTED_POSSIBLE, reverse_control=rev, rates=cfg.learning)
+            believed = {int(t) for t, p in zip(B.succ[state, h], B.prob[state, h], strict=True) if p > 0}
+            for t in sorted((believed | {n}) - {state, -1}):  # states this move is believed to reach
+                free = not self._path_blocked(h, t, obstacles, scan, pose)
+                event = Event.PREDICTED_POSSIBLE if free and t == n else Event.PREDICTED_IMPOSSIBLE
+                if free and t != n:
+                    continue  # another state now lies in that direction: leave this link alone
+                learn_transition(m, 0, state, h, t, event, reverse_control=rev, rates=cfg.learning)
+            if obstacles[h] or n >= 0:
                 continue
             if created >= cfg.lookahead_nodes:
                 continue

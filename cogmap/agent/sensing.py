@@ -12,14 +12,27 @@ from __future__ import annotations
 import numpy as np
 
 
+def scan_points(ranges: np.ndarray, beam_angles: np.ndarray, max_range: float = 12.0) -> np.ndarray:
+    """Returns of a scan as points relative to the robot (in the frame of ``beam_angles``)."""
+    r = np.asarray(ranges, dtype=float)
+    hit = np.isfinite(r) & (r < max_range - 1e-6)
+    return r[hit, None] * np.stack([np.cos(beam_angles[hit]), np.sin(beam_angles[hit])], axis=1)
+
+
+def blocked(points: np.ndarray, moves: np.ndarray, half_width: float) -> np.ndarray:
+    """For each move vector (relative to the robot), whether a return lies in its corridor."""
+    moves = np.atleast_2d(np.asarray(moves, dtype=float))
+    length = np.hypot(moves[:, 0], moves[:, 1])
+    unit = moves / np.maximum(length, 1e-9)[:, None]
+    along = points @ unit.T  # (points, moves)
+    across = points @ np.stack([-unit[:, 1], unit[:, 0]])
+    inside = (along > -half_width) & (along < length + half_width) & (np.abs(across) < half_width)
+    return inside.any(axis=0)
+
+
 def corridor_obstacles(ranges: np.ndarray, beam_angles: np.ndarray, num_headings: int, step: float,
                        half_width: float, max_range: float = 12.0) -> np.ndarray:
     """One bool per heading ``2 pi k / num_headings`` (angles in the same frame as the beams)."""
-    r = np.asarray(ranges, dtype=float)
-    hit = np.isfinite(r) & (r < max_range - 1e-6)
-    pts = r[hit, None] * np.stack([np.cos(beam_angles[hit]), np.sin(beam_angles[hit])], axis=1)
     h = 2 * np.pi * np.arange(num_headings) / num_headings
-    along = pts @ np.stack([np.cos(h), np.sin(h)])  # (points, headings)
-    across = pts @ np.stack([-np.sin(h), np.cos(h)])
-    inside = (along > -half_width) & (along < step + half_width) & (np.abs(across) < half_width)
-    return inside.any(axis=0)
+    moves = step * np.stack([np.cos(h), np.sin(h)], axis=1)
+    return blocked(scan_points(ranges, beam_angles, max_range), moves, half_width)
