@@ -29,7 +29,7 @@ def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> 
         poses = agent.poses
         for a, b, data in g.edges(data=True):
             ax.plot(*poses[[a, b]].T, color="tab:blue", lw=0.4 + 2.0 * data["prob"], alpha=0.6, zorder=4)
-        visited = agent.model.live_pA(0).max(axis=0) > 2 * agent.cfg.prior_count
+        visited = agent.visited()
         obs = agent.model.live_A(0).argmax(axis=0)
         ax.scatter(*poses[~visited].T, s=18, facecolors="white", edgecolors="tab:blue", zorder=5,
                    label="predicted (unvisited) states")

@@ -257,6 +257,10 @@ class AIMAPPAgent:
     def _reverse(self, action: int) -> int | None:
         return reverse_heading(action, self.cfg.num_headings) if action != self.cfg.stay else None
 
+    def visited(self) -> np.ndarray:
+        """Mask of states whose observation model has been taught (the agent has been there)."""
+        return self.model.live_pA(0).max(axis=0) > 2 * self.cfg.prior_count
+
     def _recognised(self, state: int, obs: int) -> bool:
         """``obs`` has been tied to ``state`` before and to no other state as strongly."""
         m = self.model
@@ -264,7 +268,7 @@ class AIMAPPAgent:
         return counts[state] > 2 * self.cfg.prior_count and counts.argmax() == state
 
     def _visited_prior(self) -> np.ndarray:
-        visited = self.model.live_pA(0).max(axis=0) > 2 * self.cfg.prior_count
+        visited = self.visited()
         return visited / visited.sum() if visited.any() else np.full(self.num_states, 1.0 / self.num_states)
 
     def _learn(self, state: int, obs: int, sensed: Sensed, pose: np.ndarray, score: float) -> int:

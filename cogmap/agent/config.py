@@ -31,7 +31,7 @@ class AgentConfig:
     collision_preference: float = -6.0  # log-preference of a collision outcome
     prior_count: float = 0.1  # Dirichlet mass of a new column (A_o: spread over the outcomes; B_s: on staying)
     obs_learning_rate: float = 4.0  # counts added when an observation is tied to a state
-    relocalise_ssim: float = 0.9  # a recognised view this similar re-localises the metric pose
+    relocalise_ssim: float = 0.9  # a recognised view this similar (about 0.1 m away) re-localises the pose
     lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)
     learning: LearningRates = field(default_factory=LearningRates)
     initial_capacity: int = 64

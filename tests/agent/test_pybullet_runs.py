@@ -61,3 +61,90 @@ def test_camera_dropout_pauses_then_resumes_in_pybullet():
         assert np.hypot(*(agent.believed_pose(sim.odometry()) - sim.true_pose()[:2])) < 0.05
     finally:
         sim.close()
+
+
+def _explored(env, seed, steps, noise=None):
+    cfg = default_config(env)
+    sim = make_sim(env, cfg, seed, noise)
+    agent = AIMAPPAgent(cfg, seed=seed)
+    episode = run_agent(sim, agent, steps, progress=False)
+    return sim, agent, episode
+
+
+def _farthest_visited(agent, xy):
+    visited = np.flatnonzero(agent.visited())
+    return int(visited[np.argmax(np.hypot(*(agent.poses[visited] - xy).T))])
+
+
+def _goal_run(env, seed, explore_steps, noise=None):
+    from cogmap.goal import pursue
+
+    sim, agent, ep = _explored(env, seed, explore_steps, noise)
+    try:
+        goal_state = _farthest_visited(agent, agent.believed_pose(sim.odometry()))
+        goal_obs = int(agent.model.live_A(0)[:, goal_state].argmax())
+        _, summary = pursue(sim, agent, goal_obs, 80, progress=False)
+        return ep.coverage[-1], agent.lost_events, summary
+    finally:
+        sim.close()
+
+
+def test_goal_reaching_in_the_house_four_of_five_seeds_within_twice_astar():
+    runs = [_goal_run("house", seed, 150) for seed in range(5)]
+    reached = [s for _, _, s in runs if s["reached"]]
+    assert len(reached) >= 4, runs
+    assert all(s["path_ratio"] <= 2.0 for s in reached), [s["path_ratio"] for s in reached]
+    assert all(s["astar_m"] > 8.0 for s in reached)  # goals across the house, not next door
+    assert all(lost == 0 for _, lost, _ in runs)  # the lost test stays quiet in normal operation
+
+
+def test_goal_reaching_with_five_percent_odometry_drift():
+    from cogmap.envs import OdometryNoise
+
+    runs = [_goal_run("small_warehouse", seed, 100, OdometryNoise(slip=0.05)) for seed in range(3)]
+    assert all(s["reached"] for _, _, s in runs), runs
+
+
+def test_kidnapped_robot_is_noticed_and_found_again():
+    for seed in range(2):
+        sim, agent, _ = _explored("mini_warehouse", seed, 60)
+        try:
+            assert agent.lost_events == 0
+            far = _farthest_visited(agent, sim.true_pose()[:2])
+            assert np.hypot(*(agent.poses[far] - sim.true_pose()[:2])) > 3.0
+            sim.teleport((*agent.poses[far], sim.true_pose()[2]))  # odometry does not notice
+            modes: list[str] = []
+            run_agent(sim, agent, 20, progress=False, on_step=lambda d, out=modes: out.append(d.mode))
+            assert "relocalise" in modes[:3] and agent.lost_events == 1
+            assert agent.relocalisations == 1 and modes[-1] == "explore"
+            assert np.hypot(*(agent.believed_pose(sim.odometry()) - sim.true_pose()[:2])) < 1.2
+        finally:
+            sim.close()
+
+
+def test_box_moved_onto_a_node_lowers_transitions_into_it():
+    sim, agent, _ = _explored("mini_warehouse", 2, 60)
+    try:
+        P = agent.poses
+        here = sim.true_pose()[:2]
+        visited = np.flatnonzero(agent.visited())
+        node = next(int(s) for s in visited if 1.6 < P[s, 0] < 5.0 and 1.3 < P[s, 1] < 4.7
+                    and np.hypot(*(P[s] - here)) > 1.5 and np.hypot(*(P[s] - [3.3, 3.0])) > 1.2)
+        sim.move_obstacle("central_box", tuple(P[node]))
+        B = agent.model.B[0]
+
+        def p_move(s, n):
+            return max((B.prob[s, a, k] for a in range(12) for k in range(B.slots) if B.succ[s, a, k] == n),
+                       default=0.0)
+
+        neighbours = [s for s in range(agent.num_states) if s != node and np.hypot(*(P[s] - P[node])) < 1.2]
+        assert min(p_move(s, node) for s in neighbours) > 0.9
+        states = []
+        ep = run_agent(sim, agent, 25, progress=False, on_step=lambda d: states.append(d.state))
+        came_back = [s for s in neighbours if s in states]
+        assert came_back
+        assert all(p_move(s, node) <= 0.5 for s in came_back)
+        assert all(r["state"] != node for r in ep.rows)  # never believed itself inside the box
+        assert sum(r["moved"] is False for r in ep.rows) <= 1
+    finally:
+        sim.close()
