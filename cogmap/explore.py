@@ -87,7 +87,7 @@ def act(sim, agent: AIMAPPAgent, d: Decision) -> bool:
 
 
 def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episode: Episode | None = None,
-              on_step=None, stop=None) -> Episode:
+              on_step=None, stop=None, desc: str = "explore") -> Episode:
     """Drive ``agent`` in ``sim`` for ``steps`` decisions, tracking LiDAR coverage."""
     from tqdm import tqdm
 
@@ -98,7 +98,7 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
     tracker = sim._coverage
     moved: bool | None = None
     dist = ep.distance[-1] if ep.distance else 0.0
-    bar = tqdm(range(steps), disable=not progress, desc="explore", unit="step", leave=True)
+    bar = tqdm(range(steps), disable=not progress, desc=desc, unit="step", leave=True)
     for _ in bar:
         tracker.update(sim.lidar_hits()[0])
         sensed = sense(sim, moved, agent.cfg)
@@ -159,7 +159,7 @@ def episode_metrics(sim, ep: Episode) -> dict:
     }
 
 
-def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict) -> None:
+def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, title: str | None = None) -> None:
     from cogmap.genmodel.graph import write_graphml
     from cogmap.genmodel.io import save
 
@@ -179,7 +179,7 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict) ->
         w.writeheader()
         w.writerows(ep.rows)
     (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
-    plots.map_over_floorplan(out / "map.png", sim, agent, ep)
+    plots.map_over_floorplan(out / "map.png", sim, agent, ep, title)
     plots.coverage_curve(out / "coverage.png", ep)
 
 

@@ -61,7 +61,7 @@ def pursue(sim, agent: AIMAPPAgent, goal_obs: int, steps: int, progress: bool = 
     episode and summary (reached, path length, A* length, ratio)."""
     agent.set_goal(goal_obs)
     start = sim.true_pose()[:2].copy()
-    ep = run_agent(sim, agent, steps, progress, stop=lambda d: agent.at_goal)
+    ep = run_agent(sim, agent, steps, progress, stop=lambda d: agent.at_goal, desc="goal")
     end = sim.true_pose()[:2]
     executed = ep.distance[-1]
     optimal = astar_length(sim.grid, start, end, sim.config.robot_radius)
@@ -96,7 +96,10 @@ def reach_goal(run: Path, goal_image: str | None = None, goal_obs: int | None = 
         write_manifest(out, command="goal", run=str(run), goal_obs=goal_obs, steps=steps, seed=seed)
         ep, summary = pursue(sim, agent, goal_obs, steps, progress)
         metrics = {**episode_metrics(sim, ep), **summary}
-        write_run(out, sim, agent, ep, metrics)
+        verdict = "reached" if metrics["reached"] else "not reached"
+        ratio = f", {metrics['path_ratio']:.2f}x A*" if metrics["path_ratio"] else ""
+        title = f"{sim.layout.name}: goal {verdict} after {metrics['executed_m']:.1f} m{ratio}"
+        write_run(out, sim, agent, ep, metrics, title)
         return metrics
     finally:
         sim.close()

@@ -23,3 +23,11 @@ def test_page_runs(page):
             exec(compile(block, f"{page}[block {i}]", "exec"), namespace)
         except Exception as err:  # pragma: no cover - the message is the point
             raise AssertionError(f"{page} block {i} failed: {err!r}\n{block}") from err
+
+
+def test_every_linked_picture_and_page_exists():
+    for page in [*DOCS.glob("*.md"), DOCS.parent / "README.md"]:
+        for target in re.findall(r"\]\(([^)#]+)\)", page.read_text()):
+            if target.startswith("http"):
+                continue
+            assert (page.parent / target).exists(), f"{page.name} links to missing {target}"
