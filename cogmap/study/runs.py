@@ -50,13 +50,11 @@ def _noise(spec):
 
 
 def study_sim(env: str, cfg, seed: int, noise=None):
-    """A simulator whose start is ``layout.starts[seed % n]``: consecutive seeds start from
-    different places (the paper starts every trial from a different position)."""
+    """A simulator whose start is ``layout.starts[seed % n]`` (see ``cogmap.explore.make_sim``):
+    consecutive seeds start from different places, as in the paper."""
     from cogmap.explore import make_sim
 
-    sim = make_sim(env, cfg, seed, noise)
-    sim.reset(seed, start=seed % len(sim.layout.starts))
-    return sim
+    return make_sim(env, cfg, seed, noise)
 
 
 def _curve(ep, points: int = 120) -> dict:
