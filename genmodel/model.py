@@ -11,7 +11,7 @@ The model holds data only; the maths lives in pure functions (``cogmap.inference
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -59,7 +59,6 @@ class Model:
     collision_preference: float | None = None
     prior_count: float = 1.0
     compile_count: int = 0
-    _listeners: list = field(default_factory=list, repr=False)
 
     # -- names and shapes ------------------------------------------------------------------
     @property
