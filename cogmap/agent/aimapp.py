@@ -2,16 +2,18 @@
 
 Each :meth:`AIMAPPAgent.step` runs sense -> infer -> learn -> plan and returns where to go:
 
-1. *sense*: the panorama becomes an observation id through the encoder (a new id grows A_o);
-   the believed pose is odometry plus the correction of the last re-localisation.
-2. *infer*: the single-factor filter combines the B_s prediction of the last move with A_o
-   and A_p evidence; the confidence test decides whether the result can be trusted.
-3. *learn* (confident only): A_o associates the observation with the believed state, a
-   recognised place re-localises the pose, the executed or failed move updates B_s with the
-   Table 7 rates, the obstacle signal adds predicted (im)possible transitions, and free
-   directions beyond every node's influence radius expand the map when Eq. (7) says so.
-4. *plan*: MCTS over expected free energy (exploration or goal mode, inductive term on in goal
-   mode); when not confident the agent seeks familiar observations instead (re-localisation).
+1. *sense* (``_observe``): the panorama becomes an observation id through the encoder (a new id
+   grows A_o); the believed pose is odometry plus the correction of the last re-localisation.
+2. *infer* (``_infer``): the single-factor filter combines the B_s prediction of the last move
+   with A_o and A_p evidence; the confidence test scores the result (``confidence.py``).
+3. *learn* (``_update``): when confident, A_o ties the observation to the believed state, a
+   near-identical view re-localises the metric pose, the executed or failed move updates B_s
+   with the Table 7 rates, the obstacle signal adds predicted (im)possible transitions, and free
+   directions where no state lies yet expand the map when Eq. (7) says so. When unsure between
+   nearby states only A_o learns, under the posterior. When the lost test fires, nothing is
+   learnt until a familiar view singles out a place again.
+4. *plan* (``_decide``): MCTS over expected free energy (exploration, or goal mode with the
+   inductive term); when lost, a step in a free direction, seeking familiar views.
 
 Sensor dropouts (``None`` inputs) pause every update: the agent stays and resumes with the same
 model and beliefs when data returns.
@@ -93,7 +95,6 @@ class AIMAPPAgent:
         self.last: Decision | None = None
         self.goal_obs: int | None = None
         self.step_count = 0
-        self.lost_steps = 0
         self._outcome: bool | None = None  # reported outcome of the last real motion command
         self.lost = False  # the confidence test fired: re-localising
         self.lost_evidence = 0.0  # CUSUM statistic of conflict
@@ -240,7 +241,10 @@ class AIMAPPAgent:
 
     # -- pieces ------------------------------------------------------------------------------
     def _prior(self, moved: bool | None) -> np.ndarray:
-        """Predicted belief after the last move (Eq. 1: B_s applied to the last posterior)."""
+        """Predicted belief after the last move (Eq. 1: B_s applied to the last posterior).
+
+        A move the controller reported blocked is learnt first (experienced impossible, Table 7)
+        and predicts no change of state."""
         n = self.num_states
         q = np.zeros(n)
         q[: self.q.size] = self.q
