@@ -13,7 +13,8 @@ def _explore(args) -> int:
     from .explore import explore
 
     out = Path(args.out)
-    metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet)
+    metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
+                      patience=args.patience)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
     return 0
@@ -56,7 +57,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
     e.add_argument("--env", default="mini_warehouse", help="layout name or registered id (default: mini_warehouse)")
-    e.add_argument("--steps", type=int, default=150, help="number of decisions (default: 150)")
+    e.add_argument("--steps", type=int, default=150, help="at most this many decisions (default: 150)")
+    e.add_argument("--patience", type=int, default=20,
+                   help="end once the map has not grown and no state was visited for the first time in this "
+                        "many decisions (default: 20; 0: always run --steps)")
     e.add_argument("--seed", type=int, default=0)
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -183,9 +183,26 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
     plots.coverage_curve(out / "coverage.png", ep)
 
 
+class Done:
+    """The agent's own end of exploration: for ``patience`` decisions the map has not grown and
+    no state has been visited for the first time (no ground truth involved)."""
+
+    def __init__(self, agent: AIMAPPAgent, patience: int):
+        self.agent, self.patience, self.quiet, self.seen = agent, patience, 0, (0, 0)
+
+    def __call__(self, _decision) -> bool:
+        a = self.agent
+        seen = (a.num_states, int(a.visited().sum())) if a.model is not None else (0, 0)
+        self.quiet = self.quiet + 1 if seen == self.seen else 0
+        self.seen = seen
+        return self.patience > 0 and self.quiet >= self.patience
+
+
 def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: Path | str | None = None,
-            config: AgentConfig | None = None, progress: bool = True, noise=None) -> dict:
-    """The main job: explore ``env`` for ``steps`` decisions and write the run directory."""
+            config: AgentConfig | None = None, progress: bool = True, noise=None, patience: int = 20) -> dict:
+    """The main job: explore ``env`` for at most ``steps`` decisions (ending early once the agent
+    has nothing left to visit for ``patience`` decisions; 0 never ends early) and write the run
+    directory."""
     from .runs import write_manifest
 
     cfg = config or default_config(env)
@@ -194,10 +211,11 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
         agent = AIMAPPAgent(cfg, seed=seed)
         if out is not None:
             out = Path(out)
-            write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed,
+            write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed, patience=patience,
                            config=cfg.to_dict(), noise=None if noise is None else noise.__dict__)
-        ep = run_agent(sim, agent, steps, progress)
-        metrics = episode_metrics(sim, ep)
+        done = Done(agent, patience)
+        ep = run_agent(sim, agent, steps, progress, stop=done)
+        metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.quiet >= patience > 0}
         if out is not None:
             write_run(out, sim, agent, ep, metrics)
         return metrics

@@ -148,3 +148,11 @@ def test_box_moved_onto_a_node_lowers_transitions_into_it():
         assert sum(r["moved"] is False for r in ep.rows) <= 1
     finally:
         sim.close()
+
+
+def test_exploration_ends_by_itself_once_nothing_is_left_to_visit():
+    result = explore("mini_warehouse", steps=300, seed=0, progress=False, patience=20)
+    assert result["ended_by_agent"] and result["steps"] < 150
+    assert result["coverage"] >= 0.95
+    never = explore("mini_warehouse", steps=60, seed=0, progress=False, patience=0)
+    assert not never["ended_by_agent"] and never["steps"] == 60
