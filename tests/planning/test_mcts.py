@@ -100,11 +100,10 @@ def test_mcts_agrees_with_enumeration_on_small_models(seed):
     G = evaluate_policies(arrays, qs, pol, obj)
     best_first = np.array([G[pol[:, 0, 0] == a].min() for a in range(3)])
     order = np.sort(best_first)
-    if order[1] - order[0] < 1e-3:
-        pytest.skip("two first actions are (nearly) tied")
     cfg = MCTSConfig(depth=depth, simulations=1500, c=0.5)
     d = mcts(prepare(arrays, local=False), qs, obj, config=cfg, rng=seed)
-    assert d.action == (int(np.argmin(best_first)),)
+    near_best = np.flatnonzero(best_first <= order[0] + 1e-3)  # (nearly) tied first actions all count
+    assert d.action[0] in near_best
     # the best branch's backed-up value approaches its exhaustive EFE
     i = d.actions.tolist().index([d.action[0]])
     assert abs(d.Q[i] - best_first.min()) < 0.25 * (order[1] - order[0]) + 0.05
