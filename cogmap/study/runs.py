@@ -63,21 +63,26 @@ def _curve(ep, points: int = 120) -> dict:
     return {"distance": [round(float(v), 3) for v in d[idx]], "coverage": [round(float(v), 4) for v in c[idx]]}
 
 
+AIMAPP_PATIENCE = 20  # decisions without map growth or a first visit before AIMAPP ends (cogmap explore's default)
+
+
 def explore_episode(env: str, method: str, seed: int, steps: int, stop_coverage: float | None, noise=None):
     """Run one method in a fresh simulator; returns (sim, episode, agent-or-policy). Caller closes sim."""
     from cogmap.agent.aimapp import AIMAPPAgent
     from cogmap.baselines import FrontierConfig, FrontierExplorer, OracleConfig, OracleTour, RandomWalk, run_policy
-    from cogmap.explore import default_config, run_agent
+    from cogmap.explore import Done, default_config, run_agent
 
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
     step = cfg.influence_radius
     if method == "aimapp":
         agent = AIMAPPAgent(cfg, seed=seed)
-        stop = None
-        if stop_coverage is not None:
-            def stop(_d):
-                return sim._coverage.coverage >= stop_coverage
+        done = Done(agent, AIMAPP_PATIENCE)  # the agent declares itself finished, as the baselines do
+
+        def stop(d):
+            finished = done(d)
+            return finished or (stop_coverage is not None and sim._coverage.coverage >= stop_coverage)
+
         ep = run_agent(sim, agent, steps, progress=False, stop=stop)
         return sim, ep, agent
     if method == "frontier":
