@@ -86,16 +86,23 @@ def act(sim, agent: AIMAPPAgent, d: Decision) -> bool:
     return bool(sim.move_to(d.waypoint, frame="odom").success)
 
 
+def coverage_tracker(sim) -> CoverageTracker:
+    """The LiDAR coverage of this simulator run, over the free area reachable from where the run
+    began. Kept with the simulator so that runs that follow one another (exploration, then a
+    goal) keep adding to the same coverage."""
+    if not hasattr(sim, "_coverage"):
+        free = sim.grid.reachable(sim.true_pose()[:2])
+        sim._coverage = CoverageTracker(free, sim.grid.origin, sim.grid.resolution)
+    return sim._coverage
+
+
 def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episode: Episode | None = None,
               on_step=None, stop=None, desc: str = "explore") -> Episode:
     """Drive ``agent`` in ``sim`` for ``steps`` decisions, tracking LiDAR coverage."""
     from tqdm import tqdm
 
     ep = episode or Episode()
-    if not hasattr(sim, "_coverage"):
-        free = sim.grid.reachable(sim.true_pose()[:2])
-        sim._coverage = CoverageTracker(free, sim.grid.origin, sim.grid.resolution)
-    tracker = sim._coverage
+    tracker = coverage_tracker(sim)
     moved: bool | None = None
     dist = ep.distance[-1] if ep.distance else 0.0
     bar = tqdm(range(steps), disable=not progress, desc=desc, unit="step", leave=True)
@@ -140,12 +147,13 @@ def episode_metrics(sim, ep: Episode) -> dict:
     belief = np.array([[r["belief_x"], r["belief_y"]] for r in rows])
     ok = np.all(np.isfinite(belief), axis=1) & np.all(np.isfinite(odom), axis=1)
     dist = ep.distance[-1]
-    area = sim._coverage.area
+    tracker = coverage_tracker(sim)
+    area = tracker.area
     return {
         "steps": len(rows),
         "coverage": ep.coverage[-1],
         "area_covered_m2": area,
-        "free_area_m2": sim._coverage.total * sim.grid.resolution**2,
+        "free_area_m2": tracker.total * sim.grid.resolution**2,
         "distance_m": dist,
         "coverage_efficiency": coverage_efficiency(area, dist),
         "nauc": nauc(ep.distance, ep.coverage, budget=max(dist, 1e-9)),

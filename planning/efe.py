@@ -58,22 +58,23 @@ def state_info_gain(ctx) -> np.ndarray:
     return out
 
 
-def a_novelty(ctx) -> np.ndarray:
-    """Information gain about likelihood parameters (from ``pA``); zero without counts."""
-    out = np.zeros(ctx.num_candidates)
-    for v in ctx.a_novelty:
+def _sum_present(values, n: int) -> np.ndarray:
+    """Sum of the per-modality (or per-factor) values that exist (``None``: no counts)."""
+    out = np.zeros(n)
+    for v in values:
         if v is not None:
             out += v
     return out
+
+
+def a_novelty(ctx) -> np.ndarray:
+    """Information gain about likelihood parameters (from ``pA``); zero without counts."""
+    return _sum_present(ctx.a_novelty, ctx.num_candidates)
 
 
 def b_novelty(ctx) -> np.ndarray:
     """Information gain about transition parameters (from ``pB``); zero without counts."""
-    out = np.zeros(ctx.num_candidates)
-    for v in ctx.b_novelty:
-        if v is not None:
-            out += v
-    return out
+    return _sum_present(ctx.b_novelty, ctx.num_candidates)
 
 
 def param_info_gain(ctx) -> np.ndarray:

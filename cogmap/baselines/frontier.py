@@ -37,6 +37,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from cogmap.envs.occupancy import OccupancyGrid
+
 from .gridnav import coarsen, extract_path, inflate, line_free, next_waypoint, shortest_paths
 
 
@@ -67,18 +69,15 @@ class OdomMap:
         self.origin = (float(center_xy[0]) - n * resolution / 2, float(center_xy[1]) - n * resolution / 2)
         self.seen = np.zeros((n, n), bool)
         self.occ = np.zeros((n, n), bool)
+        self._frame = OccupancyGrid(self.occ, self.origin, resolution)  # coordinate conversions
         self.bbox = None  # (r0, r1, c0, c1) of seen cells, inclusive-exclusive
 
     def to_cell(self, xy) -> np.ndarray:
-        xy = np.asarray(xy, float)
-        c = np.floor((xy[..., 0] - self.origin[0]) / self.resolution).astype(int)
-        r = np.floor((xy[..., 1] - self.origin[1]) / self.resolution).astype(int)
-        return np.stack([r, c], axis=-1)
+        """(..., 2) odometry-frame points -> (row, col), the grid convention of the envs."""
+        return self._frame.world_to_cell(xy)
 
     def to_xy(self, rc) -> np.ndarray:
-        rc = np.asarray(rc, float)
-        return np.stack([self.origin[0] + (rc[..., 1] + 0.5) * self.resolution,
-                         self.origin[1] + (rc[..., 0] + 0.5) * self.resolution], axis=-1)
+        return self._frame.cell_to_world(rc)
 
     def _grow_bbox(self, r0, r1, c0, c1) -> None:
         if self.bbox is None:

@@ -13,15 +13,7 @@ import time
 
 import numpy as np
 
-from cogmap.explore import Episode
-from cogmap.metrics import CoverageTracker
-
-
-def coverage_tracker(sim) -> CoverageTracker:
-    if not hasattr(sim, "_coverage"):
-        free = sim.grid.reachable(sim.true_pose()[:2])
-        sim._coverage = CoverageTracker(free, sim.grid.origin, sim.grid.resolution)
-    return sim._coverage
+from cogmap.explore import Episode, coverage_tracker
 
 
 def run_policy(sim, policy, steps: int, progress: bool = False, stop_coverage: float | None = None,

@@ -70,7 +70,7 @@ def explore_episode(env: str, method: str, seed: int, steps: int, stop_coverage:
     """Run one method in a fresh simulator; returns (sim, episode, agent-or-policy). Caller closes sim."""
     from cogmap.agent.aimapp import AIMAPPAgent
     from cogmap.baselines import FrontierConfig, FrontierExplorer, OracleConfig, OracleTour, RandomWalk, run_policy
-    from cogmap.explore import Done, default_config, run_agent
+    from cogmap.explore import Done, coverage_tracker, default_config, run_agent
 
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
@@ -81,7 +81,7 @@ def explore_episode(env: str, method: str, seed: int, steps: int, stop_coverage:
 
         def stop(d):
             finished = done(d)
-            return finished or (stop_coverage is not None and sim._coverage.coverage >= stop_coverage)
+            return finished or (stop_coverage is not None and coverage_tracker(sim).coverage >= stop_coverage)
 
         ep = run_agent(sim, agent, steps, progress=False, stop=stop)
         return sim, ep, agent

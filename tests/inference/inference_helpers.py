@@ -47,40 +47,13 @@ def random_sequence(model, T, seed, missing=0.0):
     return obs, actions
 
 
-def brute_force_log_evidence(model, prior, obs, actions):
-    """log p(o_1:T) by summing over every state path (tiny models only)."""
+def _weighted_paths(model, prior, obs, actions):
+    """Every joint state path with its probability p(path, o_1:T) (tiny models only)."""
     import itertools
 
     F = len(model.factors)
-    sizes = model.num_states
-    joint_states = list(itertools.product(*[range(n) for n in sizes]))
+    joint_states = list(itertools.product(*[range(n) for n in model.num_states]))
     T = len(obs)
-    total = 0.0
-    for path in itertools.product(joint_states, repeat=T):
-        p = np.prod([prior[f][path[0][f]] for f in range(F)])
-        for t in range(T):
-            if t > 0:
-                p *= np.prod(
-                    [model.B[f][path[t][f], path[t - 1][f], actions[t - 1][f]] for f in range(F)]
-                )
-            for m, o in enumerate(obs[t]):
-                if o is None:
-                    continue
-                idx = (o,) + tuple(path[t][f] for f in model.A_deps[m])
-                p *= model.A[m][idx]
-        total += p
-    return float(np.log(total))
-
-
-def brute_force_marginals(model, prior, obs, actions):
-    """Smoothed per-factor marginals p(s_t^f | o_1:T) by path enumeration (tiny models)."""
-    import itertools
-
-    F = len(model.factors)
-    sizes = model.num_states
-    joint_states = list(itertools.product(*[range(n) for n in sizes]))
-    T = len(obs)
-    out = [[np.zeros(n) for n in sizes] for _ in range(T)]
     for path in itertools.product(joint_states, repeat=T):
         p = np.prod([prior[f][path[0][f]] for f in range(F)])
         for t in range(T):
@@ -91,9 +64,21 @@ def brute_force_marginals(model, prior, obs, actions):
             for m, o in enumerate(obs[t]):
                 if o is not None:
                     p *= model.A[m][(o,) + tuple(path[t][f] for f in model.A_deps[m])]
-        for t in range(T):
-            for f in range(F):
-                out[t][f][path[t][f]] += p
+        yield path, p
+
+
+def brute_force_log_evidence(model, prior, obs, actions):
+    """log p(o_1:T) by summing over every state path (tiny models only)."""
+    return float(np.log(sum(p for _, p in _weighted_paths(model, prior, obs, actions))))
+
+
+def brute_force_marginals(model, prior, obs, actions):
+    """Smoothed per-factor marginals p(s_t^f | o_1:T) by path enumeration (tiny models)."""
+    out = [[np.zeros(n) for n in model.num_states] for _ in range(len(obs))]
+    for path, p in _weighted_paths(model, prior, obs, actions):
+        for t, states in enumerate(path):
+            for f, s in enumerate(states):
+                out[t][f][s] += p
     return [[x / x.sum() for x in row] for row in out]
 
 
