@@ -22,7 +22,7 @@ from cogmap.metrics import CoverageTracker, coverage_efficiency, nauc, rmse
 
 TRAJ_FIELDS = [
     "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y",
-    "state", "action", "mode", "moved", "num_states", "num_obs", "coverage", "distance", "decision_ms",
+    "state", "action", "mode", "missing", "moved", "num_states", "num_obs", "coverage", "distance", "decision_ms",
 ]
 
 
@@ -107,7 +107,8 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
     dist = ep.distance[-1] if ep.distance else 0.0
     bar = tqdm(range(steps), disable=not progress, desc=desc, unit="step", leave=True)
     for _ in bar:
-        tracker.update(sim.lidar_hits()[0])
+        if not sim.faults.dropped("lidar", sim.step_count):  # a silent LiDAR senses nothing
+            tracker.update(sim.lidar_hits()[0])
         sensed = sense(sim, moved, agent.cfg)
         t0 = time.perf_counter()
         d = agent.step(sensed)
@@ -122,11 +123,12 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
         ep.rows.append(dict(
             step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
             odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], state=d.state, action=d.action,
-            mode=d.mode, moved=moved, num_states=agent.num_states,
+            mode=d.mode, missing="+".join(d.missing), moved=moved, num_states=agent.num_states,
             num_obs=0 if agent.model is None else agent.model.num_obs[0], coverage=tracker.coverage,
             distance=dist, decision_ms=ms,
         ))
-        bar.set_postfix(cov=f"{tracker.coverage:.0%}", states=agent.num_states, mode=d.mode[:5])
+        bar.set_postfix(cov=f"{tracker.coverage:.0%}", states=agent.num_states,
+                        mode=d.mode[:5] + ("-" + "/".join(d.missing) if d.missing else ""))
         if on_step is not None:
             on_step(d)
         before = sim.true_pose()[:2]
@@ -134,7 +136,8 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
         dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
         if stop is not None and stop(d):
             break
-    tracker.update(sim.lidar_hits()[0])
+    if not sim.faults.dropped("lidar", sim.step_count):
+        tracker.update(sim.lidar_hits()[0])
     ep.coverage.append(tracker.coverage)
     ep.distance.append(dist)
     return ep
@@ -193,14 +196,19 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
 
 class Done:
     """The agent's own end of exploration: for ``patience`` decisions the map has not grown and
-    no state has been visited for the first time (no ground truth involved)."""
+    no state has been visited for the first time (no ground truth involved). Decisions taken
+    while a sensor stream is silent do not count: the map cannot grow without the LiDAR, nor
+    can a view be tied to a new state without the camera."""
 
     def __init__(self, agent: AIMAPPAgent, patience: int):
         self.agent, self.patience, self.quiet, self.seen = agent, patience, 0, (0, 0)
 
-    def __call__(self, _decision) -> bool:
+    def __call__(self, decision) -> bool:
         a = self.agent
         seen = (a.num_states, int(a.visited().sum())) if a.model is not None else (0, 0)
+        if getattr(decision, "missing", ()):
+            self.seen = seen
+            return False
         self.quiet = self.quiet + 1 if seen == self.seen else 0
         self.seen = seen
         return self.patience > 0 and self.quiet >= self.patience

@@ -15,8 +15,12 @@ Each :meth:`AIMAPPAgent.step` runs sense -> infer -> learn -> plan and returns w
 4. *plan* (``_decide``): MCTS over expected free energy (exploration, or goal mode with the
    inductive term); when lost, a step in a free direction, seeking familiar views.
 
-Sensor dropouts (``None`` inputs) pause every update: the agent stays and resumes with the same
-model and beliefs when data returns.
+Degraded sensing (``None`` inputs; the paper's resilience to sensor failure, section 4.3): each
+stream is used while it reports. Without the LiDAR, the camera still localises and A_o and B_s
+still learn, but the map does not expand (nothing says which directions are free) and only
+moves along known transitions are planned. Without the camera, odometry (A_p) localises and the
+LiDAR still expands the map. Without odometry nothing places the agent on the map: it stays and
+resumes with the same model and beliefs when the stream returns.
 """
 
 from __future__ import annotations
@@ -47,6 +51,12 @@ class Sensed:
     moved: bool | None = None  # outcome of the last motion command (None: no command)
     scan: np.ndarray | None = None  # optional LiDAR returns relative to the robot (odometry frame, (n, 2))
 
+    @property
+    def missing(self) -> tuple[str, ...]:
+        """The streams that did not report: a subset of ("camera", "lidar", "odometry")."""
+        streams = (("camera", self.panorama), ("lidar", self.obstacles), ("odometry", self.odometry))
+        return tuple(name for name, value in streams if value is None)
+
 
 @dataclass
 class Decision:
@@ -58,6 +68,7 @@ class Decision:
     confidence: Confidence | None = None
     expanded: int = 0
     efe: dict = field(default_factory=dict)
+    missing: tuple[str, ...] = ()  # streams that did not report at this step
 
 
 def initial_model(cfg: AgentConfig, pose0) -> Model:
@@ -153,25 +164,28 @@ class AIMAPPAgent:
         self.step_count += 1
         if self.last is not None and self._outcome is None and sensed.moved is not None:
             self._outcome = bool(sensed.moved)  # outcome of the last real motion command
-        if sensed.panorama is None or sensed.odometry is None or sensed.obstacles is None:
-            return self._paused(sensed)
+        missing = sensed.missing
+        if "odometry" in missing or (self.model is None and missing):
+            return self._paused(sensed)  # nothing places the agent (or a first view is incomplete)
         pose = self.believed_pose(sensed.odometry)
         if self.model is None:
             self.model = initial_model(self.cfg, pose)
             self.q = np.ones(1)
-        obs, score = self._observe(sensed.panorama)
+        obs, score = self._observe(sensed.panorama) if sensed.panorama is not None else (None, 0.0)
         q, conf = self._infer(obs, pose)
         expanded = self._update(q, conf, obs, sensed, pose, score)
         decision = self._decide(sensed, pose, conf, expanded)
+        decision.missing = missing
         self.last, self._outcome = decision, None
         return decision
 
     # -- the cycle -------------------------------------------------------------------------
     def _paused(self, sensed: Sensed) -> Decision:
-        """A stream is silent: stay, change nothing, resume when it returns."""
+        """Odometry is silent (or the very first view is incomplete): stay, change nothing,
+        resume when it returns."""
         state = -1 if self.last is None else self.last.state
         here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
-        return Decision(self.cfg.stay, here, state, state, "paused")
+        return Decision(self.cfg.stay, here, state, state, "paused", missing=sensed.missing)
 
     def _observe(self, panorama) -> tuple[int, float]:
         """Observation id (a new id grows A_o) and the encoder's best similarity score."""
@@ -183,29 +197,32 @@ class AIMAPPAgent:
             self.model.add_observation(0, count=self.cfg.prior_count / (self.model.num_obs[0] + 1))
         return obs, float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
 
-    def _infer(self, obs: int, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
-        """Posterior over states and the confidence test (section 3.3, A.1.2)."""
+    def _infer(self, obs: int | None, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
+        """Posterior over states and the confidence test (section 3.3, A.1.2); ``obs`` is None
+        while the camera is silent (the pose evidence alone then localises)."""
         cfg = self.cfg
         if self.lost:  # re-localising: odometry is not trusted, only what is seen
             prior = self._visited_prior()
-            q, _ = bayes_filter(self.model, [prior], [{"view": obs}])
+            q = [prior] if obs is None else bayes_filter(self.model, [prior], [{"view": obs}])[0]
         else:  # B_s prediction combined with A_o and A_p evidence
             prior = self._prior(self._outcome)
             q, _ = bayes_filter(self.model, [prior], [{"view": obs, "pose": pose}])
         q = q[0]
         d2 = np.sum((self.poses - pose) ** 2, axis=1)
         near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are
-        conf = assess(q, near, self.model.live_A(0)[obs], cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
+        row = None if obs is None else self.model.live_A(0)[obs]
+        conf = assess(q, near, row, cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
         return q, conf
 
-    def _update(self, q: np.ndarray, conf: Confidence, obs: int, sensed: Sensed, pose: np.ndarray,
+    def _update(self, q: np.ndarray, conf: Confidence, obs: int | None, sensed: Sensed, pose: np.ndarray,
                 score: float) -> int:
         """Lost/found bookkeeping and learning; returns how many states the map gained."""
         cfg = self.cfg
         state = int(np.argmax(q))
         expanded = 0
         if self.lost:
-            if q[state] >= 0.5 and self._recognised(state, obs):  # a familiar view singles out a place
+            # a familiar view singles out a place
+            if obs is not None and q[state] >= 0.5 and self._recognised(state, obs):
                 self.lost, self.lost_evidence = False, 0.0
                 self.offset += self.poses[state] - pose  # found again: trust the map's pose
                 self.relocalisations += 1
@@ -217,7 +234,7 @@ class AIMAPPAgent:
             self.lost_evidence = conf.lost_evidence
             if conf.confident:
                 expanded = self._learn(state, obs, sensed, pose, score)
-            else:  # unsure between nearby states: learn A_o under the posterior (Eq. 8 weights by Q(s))
+            elif obs is not None:  # unsure between nearby states: learn A_o under the posterior (Eq. 8)
                 learn_observation(self.model, 0, obs, [q], lr=cfg.obs_learning_rate)
         self.q = np.zeros(self.num_states)
         self.q[: q.size] = q
@@ -229,6 +246,8 @@ class AIMAPPAgent:
         if self.lost:
             # The map position is unknown, so the graph cannot guide a move: step in a free
             # direction of the real surroundings until a familiar view is recognised.
+            if sensed.obstacles is None:  # nothing says which way is free: wait for the LiDAR
+                return Decision(cfg.stay, pose - self.offset, state, state, "relocalise", conf, expanded)
             free = np.flatnonzero(~np.asarray(sensed.obstacles, dtype=bool))
             action = int(self.rng.choice(free)) if free.size else cfg.stay
             waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
@@ -275,20 +294,21 @@ class AIMAPPAgent:
         visited = self.visited()
         return visited / visited.sum() if visited.any() else np.full(self.num_states, 1.0 / self.num_states)
 
-    def _learn(self, state: int, obs: int, sensed: Sensed, pose: np.ndarray, score: float) -> int:
+    def _learn(self, state: int, obs: int | None, sensed: Sensed, pose: np.ndarray, score: float) -> int:
         m, cfg = self.model, self.cfg
-        onehot = np.zeros(self.num_states)
-        onehot[state] = 1.0
-        if self._recognised(state, obs) and score >= cfg.relocalise_ssim:
-            # a familiar view, nearly identical: re-localise the metric pose on it (drift correction)
-            self.offset += self.poses[state] - pose
-        learn_observation(m, 0, obs, [onehot], lr=cfg.obs_learning_rate)
+        if obs is not None:
+            onehot = np.zeros(self.num_states)
+            onehot[state] = 1.0
+            if self._recognised(state, obs) and score >= cfg.relocalise_ssim:
+                # a familiar view, nearly identical: re-localise the metric pose on it (drift correction)
+                self.offset += self.poses[state] - pose
+            learn_observation(m, 0, obs, [onehot], lr=cfg.obs_learning_rate)
         last = self.last
         arrived = last is None or state != last.state
         if last is not None and self._outcome and state != last.state and last.action != cfg.stay:
             learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
                              reverse_control=self._reverse(last.action), rates=cfg.learning)
-        if not arrived:
+        if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
             return 0
         return self._expand(state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan, pose)
 
@@ -318,10 +338,13 @@ class AIMAPPAgent:
         cfg = self.cfg
         return bool(blocked(scan, self.poses[target] - pose, cfg.robot_radius + cfg.obstacle_margin)[0])
 
-    def _move_obstacles(self, state: int, obstacles: np.ndarray, scan: np.ndarray | None,
+    def _move_obstacles(self, state: int, obstacles: np.ndarray | None, scan: np.ndarray | None,
                         pose: np.ndarray) -> np.ndarray:
         """Collision flag per heading for the move the agent would make: toward the believed
-        successor when there is one, else straight along the heading."""
+        successor when there is one, else straight along the heading. Without the LiDAR only
+        moves along known transitions are offered."""
+        if obstacles is None:
+            return np.array([self._waypoint(state, h)[0] == state for h in range(self.cfg.num_headings)])
         flags = np.asarray(obstacles, dtype=bool).copy()
         if scan is None:
             return flags

@@ -47,18 +47,63 @@ def test_command_line_main_job_writes_a_complete_run(tmp_path, capsys):
     assert "coverage" in capsys.readouterr().out
 
 
-def test_camera_dropout_pauses_then_resumes_in_pybullet():
+def test_camera_dropout_keeps_moving_and_mapping_on_odometry_and_lidar():
     cfg = default_config("mini_warehouse")
     sim = make_sim("mini_warehouse", cfg, 0)
     try:
         agent = AIMAPPAgent(cfg, seed=0)
-        modes = []
-        sim.inject_fault("camera", 6, 4)
-        run_agent(sim, agent, 16, progress=False, on_step=lambda d: modes.append(d.mode))
-        assert modes[6:10] == ["paused"] * 4
-        assert "paused" not in modes[:6] + modes[10:]
+        decisions = []
+        sim.inject_fault("camera", 6, 6)
+        run_agent(sim, agent, 16, progress=False, on_step=decisions.append)
+        silent = decisions[6:12]
+        assert [d.missing for d in silent] == [("camera",)] * 6
+        assert all(not d.missing for d in decisions[:6] + decisions[12:])
+        assert "paused" not in [d.mode for d in decisions]
+        assert sum(d.action != cfg.stay for d in silent) >= 4  # it keeps exploring without the camera
         assert agent.lost_events == 0
         assert np.hypot(*(agent.believed_pose(sim.odometry()) - sim.true_pose()[:2])) < 0.05
+    finally:
+        sim.close()
+
+
+def test_lidar_dropout_localises_by_camera_and_moves_only_along_known_transitions():
+    cfg = default_config("mini_warehouse")
+    sim = make_sim("mini_warehouse", cfg, 1)
+    try:
+        agent = AIMAPPAgent(cfg, seed=1)
+        run_agent(sim, agent, 12, progress=False)
+        known = agent.num_states
+        decisions = []
+        sim.inject_fault("lidar", sim.step_count, 8)
+        run_agent(sim, agent, 8, progress=False, on_step=decisions.append)
+        assert [d.missing for d in decisions] == [("lidar",)] * 8
+        assert all(d.expanded == 0 for d in decisions) and agent.num_states == known  # no expansion blind
+        moves = [d for d in decisions if d.action != cfg.stay]
+        assert moves and all(d.target != d.state for d in moves)  # only toward states it knows
+        assert all(d.mode == "explore" for d in decisions)
+        assert np.hypot(*(agent.believed_pose(sim.odometry()) - sim.true_pose()[:2])) < 0.05
+        after = []
+        run_agent(sim, agent, 10, progress=False, on_step=after.append)
+        assert not any(d.missing for d in after) and agent.num_states > known  # expands again
+    finally:
+        sim.close()
+
+
+def test_thirty_step_lidar_dropout_does_not_end_exploration():
+    from cogmap.explore import Done
+
+    cfg = default_config("house")
+    sim = make_sim("house", cfg, 0)
+    try:
+        agent = AIMAPPAgent(cfg, seed=0)
+        done = Done(agent, 20)
+        sim.inject_fault("lidar", 10, 30)
+        ep = run_agent(sim, agent, 90, progress=False, stop=done)
+        assert len(ep.rows) == 90  # 30 blind decisions do not count toward the patience of 20
+        assert sum(r["missing"] == "lidar" for r in ep.rows) == 30
+        covered_blind = ep.coverage[39] - ep.coverage[10]
+        assert covered_blind == 0.0  # a silent LiDAR adds no coverage
+        assert ep.coverage[-1] > ep.coverage[40] + 0.2  # exploration goes on after the dropout
     finally:
         sim.close()
 
