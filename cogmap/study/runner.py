@@ -36,6 +36,11 @@ def write_json_atomic(path: Path, data) -> None:
     os.replace(tmp, path)
 
 
+def same_spec(stored, spec: dict) -> bool:
+    """A stored run is reused only when its spec equals this one exactly (after a JSON round trip)."""
+    return stored == json.loads(json.dumps(spec))
+
+
 def load_runs(study_dir: Path) -> dict[str, dict]:
     out = {}
     for p in sorted((Path(study_dir) / "runs").glob("*.json")):
@@ -98,12 +103,15 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     study_dir = Path(out_dir) / name
     runs_dir = study_dir / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)
-    done = load_runs(study_dir)
+    stored = load_runs(study_dir)  # files of other scales or settings stay, but are never used here
+    done = {s["key"]: stored[s["key"]] for s in specs
+            if s["key"] in stored and same_spec(stored[s["key"]].get("spec"), s)}
     todo = [s for s in specs if s["key"] not in done]
+    missing = len(todo)
     if limit is not None:
         todo = todo[:limit]
     t0 = time.perf_counter()
-    bar = tqdm(total=len(specs), initial=len(specs) - len([s for s in specs if s["key"] not in done]),
+    bar = tqdm(total=len(specs), initial=len(specs) - missing,
                disable=not progress, desc=f"{name} runs", unit="run")
 
     def sink(res):
