@@ -55,7 +55,8 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
     full = scale == "full"
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
-                  "success_rule": SuccessRule().to_dict(), "params": {}}
+                  "success_rule": SuccessRule().to_dict(), "aimapp_patience": AIMAPP_PATIENCE,
+                  "params": {}}
     if study in ("exploration", "success"):
         plan["envs"] = list(ALL_ENVS if full else ("mini_warehouse", "small_warehouse"))
         plan["methods"] = list(METHODS if study == "exploration"

@@ -148,6 +148,11 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     write_json_atomic(meta_path, meta)
     summary = {"study_dir": str(study_dir), "complete": complete, "runs": len(results), "total": len(specs),
                "wall_s": elapsed}
+    from .report import distinct_check
+
+    summary["duplicates"] = distinct_check(results)[1]
+    if summary["duplicates"]:
+        print(f"ERROR: the same run appears twice in a row of the table: {summary['duplicates']}", file=sys.stderr)
     if report and results:
         from .report import write_report
 
@@ -179,6 +184,8 @@ def run_from_args(args) -> int:
         print(summary["table"])
     print(f"{summary['runs']}/{summary['total']} runs in {summary['study_dir']} "
           f"({summary['wall_s']:.0f} s this session)")
+    if summary["duplicates"]:
+        return 4
     return 0 if summary["complete"] else 3
 
 
