@@ -241,8 +241,8 @@ def success_report(study_dir: Path, plan, results) -> str:
     groups = _groups(results, "env", "method")
     counts, _ = distinct_check(results)
     level = plan.get("coverage_level", 0.9)
-    header = ["Env.", "Method", "distinct runs", "success rate", "interventions stuck / collision / map", "failed moves",
-              f"reached {level:.0%}", "paper success", "paper interventions"]
+    header = ["Env.", "Method", "distinct runs", "success rate", "interventions stuck / collision / map",
+              "failed moves", f"reached {level:.0%}", "paper success", "paper interventions"]
     rows = []
     for env in plan["envs"]:
         for method in plan["methods"]:
