@@ -100,12 +100,16 @@ def protocol_note(plan, results, endpoint: str, success: bool = True) -> str:
     """Endpoint, success rule, run end and the distinct-run check, stated under every table."""
     counts, dups = distinct_check(results)
     ns = sorted(set(counts.values()))
+    from .config import STOP_RULE
+
+    rule = plan.get("stop_rule", "?")
+    if rule == STOP_RULE:
+        rule += (f" (AIMAPP's own end: no map growth and no first visit for {plan.get('aimapp_patience', 20)} "
+                 "decisions; frontiers: no frontier left; oracle: nothing worth a detour; random walk: budget only)")
     lines = [f"**Endpoint:** {endpoint}",
-             f"**Run end:** {plan.get('stop_rule', '?')} (AIMAPP's own end: no map growth and no first visit for "
-             f"{plan.get('aimapp_patience', 20)} decisions; frontiers: no frontier left; oracle: nothing worth a "
-             "detour; random walk: budget only). Budgets (decisions): "
-             + ", ".join(f"{e} {n}" for e, n in plan["steps"].items()) + ".",
-             f"**Runs per row:** {'/'.join(str(n) for n in ns) if ns else 0} distinct runs (seeds {plan['seeds']}; "
+             f"**Run end:** {rule}. Budgets (decisions): " + ", ".join(f"{e} {n}" for e, n in plan["steps"].items())
+             + ".",
+             f"**Runs per row:** {'/'.join(str(n) for n in ns) if ns else 0} distinct run(s) (seeds {plan['seeds']}; "
              "each seed starts from its own pose: the layout's start poses, then poses sampled from the free space, "
              "`cogmap.starts.seed_start`; distinct = different true trajectories)."]
     if success:

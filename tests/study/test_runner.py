@@ -67,10 +67,28 @@ def test_tiny_then_reduced_in_one_directory_does_not_mix(tmp_path):
     assert json.loads(path.read_text())["spec"]["steps"] == 40
 
 
+def test_the_same_run_twice_in_a_row_is_reported_as_an_error():
+    from cogmap.study.report import distinct_check, protocol_note
+
+    plan = study_plan("exploration", "tiny")
+
+    def run(seed, method, digest):
+        return {"key": f"k{seed}{method}", "spec": {"env": "mini_warehouse", "method": method, "seed": seed},
+                "result": {"trajectory_digest": digest}}
+
+    results = [run(0, "aimapp", "a"), run(1, "aimapp", "a"), run(2, "aimapp", "b"), run(0, "frontier", "a")]
+    counts, dups = distinct_check(results)
+    assert counts == {("mini_warehouse", "aimapp", None): 2, ("mini_warehouse", "frontier", None): 1}
+    assert dups == [["k0aimapp", "k1aimapp"]]  # another method with the same path is another row
+    assert "ERROR" in protocol_note(plan, results, "end")
+    assert "ERROR" not in protocol_note(plan, results[1:], "end")
+
+
 def test_resumed_study_gives_the_same_table_as_an_uninterrupted_one(tmp_path):
     kw = dict(scale="tiny", methods=["aimapp", "frontier", "random"], progress=False)
     whole = run_study("exploration", tmp_path / "whole", **kw)
-    assert whole["complete"] and whole["runs"] == 6
+    assert whole["complete"] and whole["runs"] == 6 and whole["duplicates"] == []
+    assert "2 distinct run(s)" in whole["table"] and "ERROR" not in whole["table"]
     part = run_study("exploration", tmp_path / "part", limit=2, **kw)  # "interrupted" after two runs
     assert not part["complete"] and part["runs"] == 2
     runs_dir = tmp_path / "part" / "exploration" / "runs"
