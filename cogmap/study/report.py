@@ -220,7 +220,7 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
     fig.savefig(study_dir / "coverage_curves.png", dpi=110)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(1.8 + 1.6 * len(envs), 3.4))
+    fig, ax = plt.subplots(figsize=(2.6 + 1.6 * len(envs), 4.2))
     w = 0.8 / max(1, len(plan["methods"]))
     for j, method in enumerate(plan["methods"]):
         means, stds = [], []
@@ -234,7 +234,7 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
     ax.set_xticks(np.arange(len(envs)) + w * (len(plan["methods"]) - 1) / 2)
     ax.set_xticklabels(envs, fontsize=8)
     ax.set_ylabel(f"CE at {level:.0%} coverage (m²/m)\nsuccessful runs")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, frameon=False)
     fig.tight_layout()
     fig.savefig(study_dir / "coverage_efficiency.png", dpi=110)
     plt.close(fig)
