@@ -20,7 +20,7 @@ STOP_RULE = "own end or decision budget"
 FIXED_STEPS = "fixed number of decisions"  # obstacle and scaling studies follow one run for a set time
 AIMAPP_PATIENCE = 20
 
-# options of each method that change its runs (part of every run's key)
+# options of each method that change its runs (part of every run's key); see method_options()
 METHOD_OPTIONS = {
     "aimapp": {"patience": AIMAPP_PATIENCE},
     "frontier": {"goal": "nearest reachable cell"},
@@ -28,6 +28,23 @@ METHOD_OPTIONS = {
     "random": {},
     "oracle": {},
 }
+
+
+def method_options(method: str, env: str) -> dict:
+    """Everything that configures ``method`` in ``env``: :data:`METHOD_OPTIONS` plus the full
+    configuration (AIMAPP's ``AgentConfig`` for the environment; the baselines' config dataclass,
+    whose step length, robot radius and LiDAR range the run sets from the simulator)."""
+    from dataclasses import asdict
+
+    from cogmap.baselines import FrontierConfig, FrontierPaperConfig, OracleConfig
+    from cogmap.explore import default_config
+
+    if method not in METHOD_OPTIONS:
+        raise ValueError(f"unknown method {method!r}; choose from {list(METHOD_OPTIONS)}")
+    config = {"aimapp": lambda: default_config(env).to_dict(), "frontier": lambda: asdict(FrontierConfig()),
+              "frontier_paper": lambda: asdict(FrontierPaperConfig()), "oracle": lambda: asdict(OracleConfig()),
+              "random": dict}[method]()
+    return json.loads(json.dumps({**METHOD_OPTIONS[method], "config": config}))
 
 # decision budget per environment
 STEPS_FULL = {
@@ -116,8 +133,9 @@ def spec_digest(spec: dict) -> str:
 
 def run_specs(plan: dict) -> list[dict]:
     """One JSON-able spec per run. The key is readable (env, method, seed, level) plus a digest of
-    the whole spec (study, scale, steps, noise level, stop rule, success rule, method options,
-    study parameters), so a changed setting never reuses an old run."""
+    the whole spec (study, scale, steps, noise level and its parameters, stop rule, success rule,
+    method options and configuration, study parameters), so a changed setting never reuses an old
+    run."""
     from cogmap.explore import layout_name
 
     unknown = [m for m in plan["methods"] if m not in METHOD_OPTIONS]
@@ -129,14 +147,15 @@ def run_specs(plan: dict) -> list[dict]:
     levels = plan["params"].get("levels", [None])
     for env in plan["envs"]:
         for method in plan["methods"]:
+            options = method_options(method, env)
             for level in levels:
                 for seed in plan["seeds"]:
                     spec = {
                         "study": plan["study"], "scale": plan["scale"], "env": env, "method": method,
-                        "seed": int(seed), "level": level, "steps": plan["steps"][env],
-                        "stop_rule": plan["stop_rule"], "coverage_level": plan["coverage_level"],
-                        "success_rule": plan["success_rule"], "method_options": METHOD_OPTIONS[method],
-                        "params": plan["params"],
+                        "seed": int(seed), "level": level, "noise": DRIFT_LEVELS[level] if level else None,
+                        "steps": plan["steps"][env], "stop_rule": plan["stop_rule"],
+                        "coverage_level": plan["coverage_level"], "success_rule": plan["success_rule"],
+                        "method_options": options, "params": plan["params"],
                     }
                     name = f"{env}__{method}__s{seed}" + (f"__{level}" if level is not None else "")
                     specs.append({"key": f"{name}__{spec_digest(spec)}", **spec})

@@ -44,10 +44,8 @@ def _clean(x):
 
 def _noise(spec):
     from cogmap.envs import OdometryNoise
-    from cogmap.study.config import DRIFT_LEVELS
 
-    level = spec.get("level")
-    return OdometryNoise(**DRIFT_LEVELS[level]) if level else None
+    return OdometryNoise(**spec["noise"]) if spec.get("noise") else None
 
 
 def study_sim(env: str, cfg, seed: int, noise=None):
@@ -64,8 +62,9 @@ def _curve(ep, points: int = 120) -> dict:
     return {"distance": [round(float(v), 3) for v in d[idx]], "coverage": [round(float(v), 4) for v in c[idx]]}
 
 
-def make_policy(method: str, sim, step: float, seed: int):
-    """The baseline policy of ``method`` with the simulator's robot and LiDAR."""
+def make_policy(method: str, sim, step: float, seed: int, config: dict | None = None):
+    """The baseline policy of ``method`` with the simulator's robot and LiDAR; ``config`` (the
+    spec's ``method_options["config"]``) overrides the config dataclass's defaults."""
     from cogmap.baselines import (
         FrontierConfig,
         FrontierExplorer,
@@ -76,19 +75,21 @@ def make_policy(method: str, sim, step: float, seed: int):
         RandomWalk,
     )
 
-    robot = {"robot_radius": sim.config.robot_radius, "lidar_range": sim.config.lidar_range}
+    own = {**(config or {}), "step_length": step, "robot_radius": sim.config.robot_radius,
+           "lidar_range": sim.config.lidar_range}
     if method == "frontier":
-        return FrontierExplorer(FrontierConfig(step_length=step, **robot))
+        return FrontierExplorer(FrontierConfig(**own))
     if method == "frontier_paper":
-        return FrontierPaperExplorer(FrontierPaperConfig(step_length=step, **robot))
+        return FrontierPaperExplorer(FrontierPaperConfig(**own))
     if method == "random":
         return RandomWalk(step, seed=seed)
     if method == "oracle":
-        return OracleTour(OracleConfig(step_length=step, **robot))
+        return OracleTour(OracleConfig(**{k: v for k, v in own.items() if k in OracleConfig.__dataclass_fields__}))
     raise ValueError(f"unknown method {method!r}")
 
 
-def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None):
+def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None,
+                    config: dict | None = None):
     """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
     ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim."""
     from cogmap.agent.aimapp import AIMAPPAgent
@@ -104,7 +105,7 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
         done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
         ep = run_agent(sim, agent, steps, progress=False, stop=done)
         return sim, ep, agent, bool(done.patience > 0 and done.quiet >= done.patience)
-    pol = make_policy(method, sim, cfg.influence_radius, seed)
+    pol = make_policy(method, sim, cfg.influence_radius, seed, config)
     ep = run_policy(sim, pol, steps)
     return sim, ep, pol, bool(ep.rows and ep.rows[-1]["mode"] == "done")
 
@@ -146,8 +147,11 @@ def _identity(sim, ep) -> dict:
 
 
 def run_exploration(spec) -> dict:
+    opts = spec["method_options"]
+    # AIMAPP runs with default_config(env), which is what its spec records; a baseline's recorded config is used
+    config = opts.get("config") if spec["method"] != "aimapp" else None
     sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
-                                        spec["method_options"].get("patience"))
+                                        opts.get("patience"), config)
     try:
         return exploration_result(spec, sim, ep, ended)
     finally:

@@ -28,7 +28,7 @@ def test_specs_are_unique_and_cover_the_plan():
         study_plan("nope")
 
 
-def test_run_keys_change_with_every_setting_that_changes_a_run():
+def test_run_keys_change_with_every_setting_that_changes_a_run(monkeypatch):
     tiny, reduced = run_specs(study_plan("exploration", "tiny")), run_specs(study_plan("exploration", "reduced"))
     assert run_specs(study_plan("exploration", "tiny")) == tiny  # deterministic
     shared = {(s["env"], s["method"], s["seed"]) for s in tiny}
@@ -41,6 +41,14 @@ def test_run_keys_change_with_every_setting_that_changes_a_run():
         assert run_specs({**base, **change})[0]["key"] != key, change
     drift = run_specs(study_plan("drift", "reduced"))
     assert len({s["key"] for s in drift}) == len(drift)
+    severe = [s for s in drift if s["level"] == "severe"]
+    assert all(s["noise"] == {"slip": 0.08, "heading_bias": 0.05} for s in severe)
+    from cogmap.study import config
+
+    monkeypatch.setitem(config.DRIFT_LEVELS, "severe", {"slip": 0.1, "heading_bias": 0.05})
+    assert not {s["key"] for s in severe} & {s["key"] for s in run_specs(study_plan("drift", "reduced"))}
+    monkeypatch.setitem(config.METHOD_OPTIONS, "random", {"note": "another option"})
+    assert run_specs(base)[0]["key"] != key
     assert {s["method"] for s in drift} >= {"frontier", "frontier_paper"}
     with pytest.raises(ValueError):
         run_specs({**base, "methods": ["nope"]})
