@@ -135,6 +135,8 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     complete = len(results) == len(specs)
     meta_path = study_dir / "study.json"
     prev = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+    if not same_spec(prev.get("plan"), plan):  # another scale or setting in this directory: its sessions are not ours
+        prev = {}
     meta = {
         "study": name, "plan": plan, "seeds": plan["seeds"], "runs_total": len(specs), "runs_done": len(results),
         "complete": complete, "executor": executor, "workers": workers,

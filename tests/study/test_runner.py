@@ -63,6 +63,7 @@ def test_tiny_then_reduced_in_one_directory_does_not_mix(tmp_path):
     assert len(runs) == 2  # both stay on disk ...
     assert sorted(r["result"]["steps"] for r in runs.values()) == [6, 40]
     assert "mini_warehouse 6." in tiny["table"] and "mini_warehouse 40." in reduced["table"]  # ... each table its own
+    assert len(json.loads((tmp_path / "exploration" / "study.json").read_text())["sessions"]) == 1
     csv = (tmp_path / "exploration" / "runs.csv").read_text().splitlines()
     assert len(csv) == 2 and ",40," in csv[1]
     # a stored run whose spec differs from the plan's (same key) is not reused
