@@ -56,14 +56,17 @@ class Episode:
 
 
 def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
-    """The room, with the start pose chosen by the seed (each seed starts somewhere else, as
-    in the paper's protocol, cycling through the layout's start poses)."""
+    """The room, with the start pose chosen by the seed: every seed starts somewhere else, as in
+    the paper's protocol (the layout's start poses first, then poses sampled from the free
+    space; :func:`cogmap.starts.seed_start`)."""
     from cogmap.envs import NavSim, OdometryNoise, SimConfig, make_layout
+
+    from .starts import seed_start
 
     layout = make_layout(layout_name(env))
     sim_cfg = SimConfig(step_length=cfg.influence_radius, obstacle_margin=cfg.obstacle_margin,
                         noise=noise or OdometryNoise())
-    return NavSim(layout, sim_cfg, seed=seed, start=seed % len(layout.starts))
+    return NavSim(layout, sim_cfg, seed=seed, start=seed_start(layout, seed, sim_cfg.robot_radius))
 
 
 def sense(sim, moved: bool | None, cfg: AgentConfig) -> Sensed:

@@ -31,12 +31,40 @@ def times_table() -> str:
     return "\n".join(rows)
 
 
+OLD_STARTS = "seed k started at `layout.starts[k mod n]`, so a row of 5 seeds held 3-4 distinct starts"
+OLD_DEFINITIONS = {
+    "exploration": "runs stopped at 99 % coverage, CE and nAUC at the end only, success = coverage >= 90 % and no "
+                   "stall, " + OLD_STARTS + ", no `frontier_paper` row",
+    "success": "runs stopped at 99 % coverage, success = coverage >= 90 % and no stall (5 failed moves in a row or 25 "
+               "decisions without coverage gain), " + OLD_STARTS + ", no `frontier_paper` row",
+    "drift": "runs stopped at 99 % coverage, " + OLD_STARTS + ", no success column, no `frontier_paper` row",
+}
+
+
+OLD_DEFINITIONS["goals"] = OLD_STARTS  # obstacle and scaling use fewer seeds than starts: nothing changed
+
+
+def old_definitions_note(study: str) -> str:
+    what = OLD_DEFINITIONS.get(study)
+    if what is None:
+        return ""
+    return f"**Made under the previous definitions** ({what}); the definitions above apply from its next re-run.\n\n"
+
+
+def made_under_old_definitions(meta: dict) -> bool:
+    """Studies run before the endpoint/success/start definitions of this page have no success rule
+    in their plan."""
+    return "success_rule" not in meta.get("plan", {})
+
+
 def tables() -> str:
     parts = []
     for name, path in studies():
         body = (path / "table.md").read_text().split("\n", 1)[1].strip()  # drop the study's own title
-        figures = " ".join(f"![{png.stem}](results/{name}/{png.name})" for png in sorted(path.glob("*.png")))
         study, scale = name.rsplit("-", 1)
+        if made_under_old_definitions(json.loads((path / "study.json").read_text())):
+            body = old_definitions_note(study) + body
+        figures = " ".join(f"![{png.stem}](results/{name}/{png.name})" for png in sorted(path.glob("*.png")))
         section = f"### {study} ({scale}) — `docs/results/{name}/`\n\n{body}\n"
         parts.append(section + (f"\n{figures}\n" if figures else ""))
     return "\n".join(parts)

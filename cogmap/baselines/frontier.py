@@ -204,6 +204,7 @@ class FrontierExplorer:
             blocked[max(0, start[0] - k):start[0] + k + 1, max(0, start[1] - k):start[1] + k + 1] = False
         dist, pred = shortest_paths(blocked, start)
         self._plan = (pred, blocked, (r0, c0))
+        self._dist = dist  # path length (planning cells) from the robot to every cell
         robot = np.asarray(odom[:2], float)
         out = []
         idx = ndimage.find_objects(labels)

@@ -1,18 +1,57 @@
-"""Study definitions: environments, methods, seeds and budgets per study and scale."""
+"""Study definitions: environments, methods, seeds and budgets per study and scale; one spec per
+run, keyed by a digest of everything that changes the run."""
 
 from __future__ import annotations
 
-STUDIES = ("exploration", "success", "goals", "drift", "obstacle", "scaling")
-METHODS = ("aimapp", "frontier", "random", "oracle")
+import hashlib
+import json
 
-# decision budget per environment (a run also ends at STOP_COVERAGE or when a baseline finishes)
+from .metrics_extra import COVERAGE_LEVEL, SuccessRule
+
+STUDIES = ("exploration", "success", "goals", "drift", "obstacle", "scaling")
+METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
+
+# How a run ends (the same rule for every study): AIMAPP by its own end of exploration
+# (cogmap.explore.Done: no map growth and no first visit for AIMAPP_PATIENCE decisions), a
+# baseline when it declares itself finished (frontiers: no frontier left; oracle: no viewpoint
+# worth visiting), every method at the environment's decision budget. No coverage stop, so the
+# 90 % endpoint and the end of the run are both measured on the same run.
+STOP_RULE = "own end or decision budget"
+FIXED_STEPS = "fixed number of decisions"  # obstacle and scaling studies follow one run for a set time
+AIMAPP_PATIENCE = 20
+
+# options of each method that change its runs (part of every run's key); see method_options()
+METHOD_OPTIONS = {
+    "aimapp": {"patience": AIMAPP_PATIENCE},
+    "frontier": {"goal": "nearest reachable cell"},
+    "frontier_paper": {"goal": "centroid"},
+    "random": {},
+    "oracle": {},
+}
+
+
+def method_options(method: str, env: str) -> dict:
+    """Everything that configures ``method`` in ``env``: :data:`METHOD_OPTIONS` plus the full
+    configuration (AIMAPP's ``AgentConfig`` for the environment; the baselines' config dataclass,
+    whose step length, robot radius and LiDAR range the run sets from the simulator)."""
+    from dataclasses import asdict
+
+    from cogmap.baselines import FrontierConfig, FrontierPaperConfig, OracleConfig
+    from cogmap.explore import default_config
+
+    if method not in METHOD_OPTIONS:
+        raise ValueError(f"unknown method {method!r}; choose from {list(METHOD_OPTIONS)}")
+    config = {"aimapp": lambda: default_config(env).to_dict(), "frontier": lambda: asdict(FrontierConfig()),
+              "frontier_paper": lambda: asdict(FrontierPaperConfig()), "oracle": lambda: asdict(OracleConfig()),
+              "random": dict}[method]()
+    return json.loads(json.dumps({**METHOD_OPTIONS[method], "config": config}))
+
+# decision budget per environment
 STEPS_FULL = {
     "mini_warehouse": 60, "small_warehouse": 100, "bedroom": 50, "random_rooms": 150,
     "house": 300, "large_warehouse": 300, "aisle_warehouse": 300, "parking_lot": 300,
 }
 STEPS_REDUCED = {"mini_warehouse": 40, "small_warehouse": 60}
-STOP_COVERAGE = 0.99
-SUCCESS_COVERAGE = 0.9
 
 ALL_ENVS = ("mini_warehouse", "small_warehouse", "large_warehouse", "house", "aisle_warehouse", "bedroom",
             "parking_lot")
@@ -32,11 +71,13 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         raise ValueError("scale must be 'reduced', 'full' or 'tiny'")
     full = scale == "full"
     tiny = scale == "tiny"
-    plan: dict = {"study": study, "scale": scale, "stop_coverage": STOP_COVERAGE,
-                  "success_coverage": SUCCESS_COVERAGE, "params": {}}
+    plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
+                  "success_rule": SuccessRule().to_dict(), "aimapp_patience": AIMAPP_PATIENCE,
+                  "params": {}}
     if study in ("exploration", "success"):
         plan["envs"] = list(ALL_ENVS if full else ("mini_warehouse", "small_warehouse"))
-        plan["methods"] = list(METHODS if study == "exploration" else ("aimapp", "frontier", "random"))
+        plan["methods"] = list(METHODS if study == "exploration"
+                               else ("aimapp", "frontier", "frontier_paper", "random"))
         plan["seeds"] = list(range(5 if full else 3))
         plan["steps"] = STEPS_FULL if full else STEPS_REDUCED
     elif study == "goals":
@@ -48,7 +89,7 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         plan["params"] = {"goals_per_run": 2, "goal_steps": 60, "min_goal_distance": 1.5}
     elif study == "drift":
         plan["envs"] = ["aisle_warehouse" if full else "small_warehouse"]
-        plan["methods"] = ["aimapp", "frontier", "oracle"]
+        plan["methods"] = ["aimapp", "frontier", "frontier_paper", "oracle"]
         plan["seeds"] = list(range(5 if full else 2))
         plan["steps"] = {"aisle_warehouse": 300, "small_warehouse": 60}
         plan["params"] = {"levels": list(DRIFT_LEVELS) if full else ["none", "severe"]}
@@ -79,21 +120,43 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
     if methods is not None:
         plan["methods"] = list(methods)
     plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, 100))) for e in plan["envs"]}
+    if study in ("obstacle", "scaling"):
+        plan["stop_rule"] = FIXED_STEPS
     return plan
 
 
+def spec_digest(spec: dict) -> str:
+    """SHA-256 (10 hex) of the canonical JSON of ``spec`` without its key."""
+    body = {k: v for k, v in spec.items() if k != "key"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()[:10]
+
+
 def run_specs(plan: dict) -> list[dict]:
-    """One JSON-able spec per run: (study, env, method, seed, config)."""
+    """One JSON-able spec per run. The key is readable (env, method, seed, level) plus a digest of
+    the whole spec (study, scale, steps, noise level and its parameters, stop rule, success rule,
+    method options and configuration, study parameters), so a changed setting never reuses an old
+    run."""
+    from cogmap.explore import layout_name
+
+    unknown = [m for m in plan["methods"] if m not in METHOD_OPTIONS]
+    if unknown:
+        raise ValueError(f"unknown method(s) {unknown}; choose from {list(METHOD_OPTIONS)}")
+    for env in plan["envs"]:
+        layout_name(env)  # a clear error for an unknown environment
     specs = []
     levels = plan["params"].get("levels", [None])
     for env in plan["envs"]:
         for method in plan["methods"]:
+            options = method_options(method, env)
             for level in levels:
                 for seed in plan["seeds"]:
-                    key = f"{env}__{method}__s{seed}" + (f"__{level}" if level is not None else "")
-                    specs.append({
-                        "key": key, "study": plan["study"], "env": env, "method": method, "seed": int(seed),
-                        "level": level, "steps": plan["steps"][env], "stop_coverage": plan["stop_coverage"],
-                        "success_coverage": plan["success_coverage"], "params": plan["params"],
-                    })
+                    spec = {
+                        "study": plan["study"], "scale": plan["scale"], "env": env, "method": method,
+                        "seed": int(seed), "level": level, "noise": DRIFT_LEVELS[level] if level else None,
+                        "steps": plan["steps"][env], "stop_rule": plan["stop_rule"],
+                        "coverage_level": plan["coverage_level"], "success_rule": plan["success_rule"],
+                        "method_options": options, "params": plan["params"],
+                    }
+                    name = f"{env}__{method}__s{seed}" + (f"__{level}" if level is not None else "")
+                    specs.append({"key": f"{name}__{spec_digest(spec)}", **spec})
     return specs

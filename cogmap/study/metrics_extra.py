@@ -1,27 +1,39 @@
-"""Study metrics beyond :mod:`cogmap.metrics`: interventions and success, drift, the three
-path-length ratios of Table 5, transition beliefs into a node (Figure 8), summaries.
+"""Study metrics beyond :mod:`cogmap.metrics`: endpoints (CE and nAUC at 90 % coverage and at the
+end of a run), interventions and success, drift, the three path-length ratios of Table 5,
+transition beliefs into a node (Figure 8), run digests, summaries.
 
 Definitions (stated once, used by every study):
 
-* **stall / intervention**: ``fail_run`` consecutive failed moves (a failed move is a
-  collision: the motion stopped before reaching its waypoint), or ``nogain_run`` consecutive
-  decisions adding less than ``min_gain`` coverage while coverage is below ``target``.
-  Counting restarts after each stall. The paper counts human interventions; we count the
-  situations in which a human would have stepped in, without stepping in.
-* **success**: final coverage >= ``coverage`` and no stall.
+* **curve**: ``distance[i]``, ``coverage[i]`` = distance travelled before decision ``i`` and the
+  LiDAR coverage seen by then (the episode lists; the last entry is after the last move).
+* **endpoint at 90 %**: the first sample ``i90`` with ``coverage >= 0.9``.
+  ``CE@90 = coverage[i90] * free_area / distance[i90]`` (area covered then / distance then; None
+  when the run never reaches 90 % or reaches it before moving). ``nAUC@90`` = the nAUC over the
+  fixed budget (below) of the curve cut at ``i90``: coverage follows the run up to ``i90`` and
+  holds ``coverage[i90]`` after it, so what a method does after reaching 90 % does not count.
+* **endpoint at the end**: the last sample. ``CE = area covered / distance`` and ``nAUC`` over the
+  budget with the last coverage held.
 * **nAUC budget**: the distance a robot sweeping a 2 m wide swath needs for the free area,
   ``free_area / 2`` metres (environment-dependent, method-independent).
+* **interventions** (the paper counts trials that needed a human, section 4.2 and Appendix D.3:
+  stuck, collision, non-recoverable map overlap); nobody intervenes here, we count the moments a
+  human would have stepped in (:class:`SuccessRule`). A run that levels off (moves without
+  coverage gain) is not a failure. **success** = no intervention.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
+from dataclasses import asdict, dataclass
 
 import numpy as np
 
 from cogmap.metrics import ate_per_metre, nauc, rmse
 
 NAUC_SWATH_M = 2.0
+COVERAGE_LEVEL = 0.9  # the paper's AIMAPP levels off near 90 % (section 4.2)
 
 
 def nauc_budget(free_area_m2: float, swath_m: float = NAUC_SWATH_M) -> float:
@@ -33,27 +45,106 @@ def nauc_over_budget(distances, coverages, budget: float) -> float:
     return nauc(distances, coverages, budget)
 
 
-def count_stalls(moved, coverage, fail_run: int = 5, nogain_run: int = 25, min_gain: float = 1e-3,
-                 target: float = 0.99) -> int:
-    """Number of stalls in a run. ``moved[i]`` is the outcome of the move before decision i
-    (None for the first), ``coverage[i]`` the coverage at decision i."""
-    stalls, fails, flat = 0, 0, 0
-    prev = None
-    for m, c in zip(moved, coverage, strict=False):
-        fails = fails + 1 if m is False else 0
-        if prev is not None and c - prev < min_gain and c < target:
-            flat += 1
-        else:
-            flat = 0
-        prev = c
-        if fails >= fail_run or flat >= nogain_run:
-            stalls += 1
-            fails, flat = 0, 0
-    return stalls
+def first_reach(coverages, level: float = COVERAGE_LEVEL) -> int | None:
+    """Index of the first sample with coverage >= ``level`` (None if never)."""
+    hit = np.flatnonzero(np.asarray(coverages, float) >= level)
+    return int(hit[0]) if hit.size else None
 
 
-def is_success(final_coverage: float, stalls: int, coverage: float = 0.9) -> bool:
-    return bool(final_coverage >= coverage and stalls == 0)
+def endpoint(distances, coverages, free_area_m2: float, budget: float, index: int) -> dict:
+    """CE and nAUC of the curve cut at sample ``index`` (coverage held after it)."""
+    d = np.asarray(distances, float)[: index + 1]
+    c = np.asarray(coverages, float)[: index + 1]
+    dist, cov = float(d[-1]), float(c[-1])
+    return {"coverage": cov, "distance_m": dist, "area_m2": cov * free_area_m2,
+            "ce": cov * free_area_m2 / dist if dist > 0 else None, "nauc": nauc(d, c, budget)}
+
+
+def endpoints(distances, coverages, free_area_m2: float, budget: float, level: float = COVERAGE_LEVEL) -> dict:
+    """``{"end": ..., "at_level": ... or None, "level_index": i or None}`` (see the module docstring)."""
+    i = first_reach(coverages, level)
+    last = len(distances) - 1
+    return {"end": endpoint(distances, coverages, free_area_m2, budget, last),
+            "at_level": None if i is None else endpoint(distances, coverages, free_area_m2, budget, i),
+            "level_index": i}
+
+
+@dataclass(frozen=True)
+class SuccessRule:
+    """When a run would have needed a human (paper section 4.2, Appendix D.3).
+
+    * **stuck**: for ``stuck_decisions`` consecutive decisions the true position stays within
+      ``stuck_radius_m`` of where that stretch began (spinning or waiting in place, or pushing
+      against something; a level-off walks between places and is not stuck).
+    * **collision**: ``collision_run`` consecutive failed moves. Our simulator stops every move
+      before contact and reports it failed, and the methods recover from a single failure by
+      their own rules (AIMAPP learns the transition is impossible, Table 7; the frontier
+      explorers blacklist a goal after 3 failures, mark bumper hits and re-plan). A human steps
+      in when the robot keeps driving into what it does not see (the paper's LiDAR blind spots:
+      "the robot collided or spun in place"): five failures in a row, more than any method's own
+      recovery allows.
+    * **map mismatch**: the believed position is more than ``mismatch_m`` from the true one for
+      ``mismatch_decisions`` consecutive decisions ("non-recoverable map overlap"). ``mismatch_m``
+      None means the agent's influence radius (1 m small rooms, 2 m large ones): beyond the spacing
+      of its places the robot files what it sees under the wrong place.
+    """
+
+    stuck_decisions: int = 15
+    stuck_radius_m: float = 0.25
+    collision_run: int = 5
+    mismatch_m: float | None = None
+    mismatch_decisions: int = 10
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def interventions(true_xy, moved, belief_xy, rule: SuccessRule, mismatch_m: float | None = None) -> list[dict]:
+    """Moments a human would have stepped in: ``[{"cause": "stuck"|"collision"|"map", "step": i}]``.
+
+    ``true_xy[i]``, ``belief_xy[i]``: positions at decision ``i``; ``moved[i]``: outcome of the move
+    before decision ``i`` (None for the first). Counting restarts after each event (nobody
+    actually steps in, so a robot that stays stuck is counted again after another stretch).
+    ``mismatch_m`` overrides ``rule.mismatch_m`` (e.g. the resolved influence radius). Belief rows
+    that are not finite (no belief) never count as a mismatch."""
+    t = np.asarray(true_xy, float).reshape(-1, 2)
+    b = np.asarray(belief_xy, float).reshape(-1, 2)
+    bound = rule.mismatch_m if mismatch_m is None else mismatch_m
+    if bound is None:
+        raise ValueError("a map-mismatch bound is needed (rule.mismatch_m or mismatch_m)")
+    events = []
+    anchor, fails, far = 0, 0, 0
+    for i in range(len(t)):
+        if np.hypot(*(t[i] - t[anchor])) > rule.stuck_radius_m:
+            anchor = i
+        elif i - anchor >= rule.stuck_decisions:
+            events.append({"cause": "stuck", "step": i})
+            anchor = i
+        fails = fails + 1 if moved[i] is False else 0
+        if fails >= rule.collision_run:
+            events.append({"cause": "collision", "step": i})
+            fails = 0
+        err = float(np.hypot(*(b[i] - t[i])))
+        far = far + 1 if math.isfinite(err) and err > bound else 0
+        if far >= rule.mismatch_decisions:
+            events.append({"cause": "map", "step": i})
+            far = 0
+    return events
+
+
+def trajectory_digest(true_xy, decimals: int = 3) -> str:
+    """SHA-256 (16 hex) of the true trajectory rounded to ``decimals`` (mm): equal digests mean
+    the same run twice."""
+    t = np.round(np.asarray(true_xy, float).reshape(-1, 2), decimals) + 0.0  # no negative zero
+    return hashlib.sha256(json.dumps(t.tolist()).encode()).hexdigest()[:16]
+
+
+def duplicates(digests: dict) -> list[list]:
+    """Groups of names sharing a digest (``{name: digest}`` -> ``[[name, name], ...]``)."""
+    by: dict = {}
+    for name, d in digests.items():
+        by.setdefault(d, []).append(name)
+    return [sorted(v) for v in by.values() if len(v) > 1]
 
 
 def drift_metrics(truth, odometry, belief) -> dict:

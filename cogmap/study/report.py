@@ -8,9 +8,13 @@ from pathlib import Path
 import numpy as np
 
 from . import paper
-from .metrics_extra import fraction_within, summarise
+from .metrics_extra import duplicates, fraction_within, summarise
 
-METHOD_LABEL = {"aimapp": "AIMAPP", "frontier": "Frontiers", "random": "Random walk", "oracle": "Oracle (manual)"}
+METHOD_LABEL = {"aimapp": "AIMAPP", "frontier": "Frontiers (nearest reachable cell)",
+                "frontier_paper": "Frontiers (explore_lite-like)", "random": "Random walk",
+                "oracle": "Oracle (manual)"}
+COLORS = {"aimapp": "C0", "frontier": "C1", "frontier_paper": "C4", "random": "C2", "oracle": "C3"}
+CAUSES = ("stuck", "collision", "map")
 
 
 def _pm(s: dict, digits: int = 2) -> str:
@@ -63,83 +67,174 @@ def _fmt(v, d=3):
     return v
 
 
+# ---------------------------------------------------------------------------- protocol
+def row_key(spec: dict) -> tuple:
+    """The table row a run belongs to: every setting but the seed."""
+    return (spec["env"], spec["method"], spec.get("level"))
+
+
+def distinct_check(results) -> tuple[dict, list[list[str]]]:
+    """Distinct runs per row (by trajectory digest) and the groups of runs that are the same run
+    twice (same row, same true trajectory): those are an error."""
+    rows: dict = {}
+    for r in results:
+        rows.setdefault(row_key(r["spec"]), {})[r["key"]] = r["result"].get("trajectory_digest") or r["key"]
+    counts = {k: len(set(v.values())) for k, v in rows.items()}
+    dups = [g for v in rows.values() for g in duplicates(v)]
+    return counts, dups
+
+
+def success_rule_text(plan) -> str:
+    r = plan.get("success_rule") or {}
+    mm = r.get("mismatch_m")
+    return ("a run fails when a human would have stepped in (paper section 4.2, Appendix D.3): **stuck** = the true "
+            f"position stays within {r.get('stuck_radius_m')} m for {r.get('stuck_decisions')} consecutive decisions; "
+            f"**collision** = {r.get('collision_run')} failed moves in a row (every move is stopped before contact and "
+            "reported failed; one failure the methods recover from themselves); **map** = the believed position more "
+            f"than {'the influence radius (1 m small rooms, 2 m large ones)' if mm is None else f'{mm} m'} from the "
+            f"true one for {r.get('mismatch_decisions')} consecutive decisions. Levelling off without coverage gain "
+            "is not a failure")
+
+
+def protocol_note(plan, results, endpoint: str, success: bool = True) -> str:
+    """Endpoint, success rule, run end and the distinct-run check, stated under every table."""
+    counts, dups = distinct_check(results)
+    ns = sorted(set(counts.values()))
+    from .config import STOP_RULE
+
+    rule = plan.get("stop_rule", "?")
+    if rule == STOP_RULE:
+        rule += (f" (AIMAPP's own end: no map growth and no first visit for {plan.get('aimapp_patience', 20)} "
+                 "decisions; frontiers: no frontier left; oracle: nothing worth a detour; random walk: budget only)")
+    lines = [f"**Endpoint:** {endpoint}",
+             f"**Run end:** {rule}. Budgets (decisions): " + ", ".join(f"{e} {n}" for e, n in plan["steps"].items())
+             + ".",
+             f"**Runs per row:** {'/'.join(str(n) for n in ns) if ns else 0} distinct run(s) (seeds {plan['seeds']}; "
+             "each seed starts from its own pose: the layout's start poses, then poses sampled from the free space, "
+             "`cogmap.starts.seed_start`; distinct = different true trajectories)."]
+    if success:
+        lines.insert(1, f"**Success:** {success_rule_text(plan)}.")
+    if dups:
+        lines.append("**ERROR: the same run appears more than once in a row:** "
+                     + "; ".join(" = ".join(g) for g in dups))
+    return "\n\n".join(lines)
+
+
+def _ep(r, where: str, key: str):
+    """``key`` of a run result at the end (``where="end"``) or at the coverage level."""
+    if where == "end":
+        return r.get(key)
+    e = r.get("at_level")
+    return None if e is None else e.get(key)
+
+
+def _causes(rs) -> str:
+    n = {c: sum(1 for r in rs for e in r.get("interventions", []) if e["cause"] == c) for c in CAUSES}
+    return " / ".join(str(n[c]) for c in CAUSES)
+
+
 # ---------------------------------------------------------------------------- exploration
 def exploration_report(study_dir: Path, plan, results) -> str:
     groups = _groups(results, "env", "method")
-    header = ["Env.", "Method", "CE (m²/m)", "nAUC", "coverage", "distance (m)", "success", "stalls",
+    counts, _ = distinct_check(results)
+    level = plan.get("coverage_level", 0.9)
+    pct = f"{level:.0%}"
+    header = ["Env.", "Method", "distinct runs", "success", f"reached {pct}",
+              f"CE@{pct} (successful)", f"CE@{pct} (all)", f"nAUC@{pct} (successful)",
+              "CE end (successful)", "nAUC end (successful)", "coverage end", "distance end (m)",
               "paper CE", "paper nAUC"]
-    rows, csv_rows = [], []
+    rows = []
     for env in plan["envs"]:
         for method in plan["methods"]:
             rs = [r["result"] for r in groups.get((env, method), [])]
             if not rs:
                 continue
-            ce, na = summarise([r["ce"] for r in rs]), summarise([r["nauc"] for r in rs])
-            cov, dist = summarise([r["coverage"] for r in rs]), summarise([r["distance_m"] for r in rs])
-            succ = sum(bool(r["success"]) for r in rs)
-            stalls = sum(int(r["stalls"]) for r in rs)
+            ok = [r for r in rs if r["success"]]
+            reached = sum(r.get("at_level") is not None for r in rs)
             pname = paper.PAPER_NAME.get(method)
             pv = paper.EXPLORATION.get(env, {}).get(pname, {}) if pname else {}
-            rows.append([env, METHOD_LABEL[method], _pm(ce), _pm(na), _pm(cov), _pm(dist, 1), f"{succ}/{len(rs)}",
-                         stalls, _paper_pm(pv.get("ce")), _paper_pm(pv.get("nauc"))])
+            rows.append([
+                env, METHOD_LABEL[method], counts.get((env, method, None), len(rs)), f"{len(ok)}/{len(rs)}",
+                f"{reached}/{len(rs)}",
+                _pm(summarise([_ep(r, "lvl", "ce") for r in ok])), _pm(summarise([_ep(r, "lvl", "ce") for r in rs])),
+                _pm(summarise([_ep(r, "lvl", "nauc") for r in ok])),
+                _pm(summarise([r["ce"] for r in ok])), _pm(summarise([r["nauc"] for r in ok])),
+                _pm(summarise([r["coverage"] for r in rs])), _pm(summarise([r["distance_m"] for r in rs]), 1),
+                _paper_pm(pv.get("ce")), _paper_pm(pv.get("nauc"))])
+    csv_rows = []
     for r in sorted(results, key=lambda r: r["key"]):
         s, x = r["spec"], r["result"]
-        csv_rows.append([s["env"], s["method"], s["seed"], _fmt(x["ce"]), _fmt(x["nauc"]), _fmt(x["nauc_budget_m"], 1),
-                         _fmt(x["coverage"]), _fmt(x["distance_m"], 2), x["steps"], x["failed_moves"], x["stalls"],
-                         x["success"], _fmt(x.get("rmse_odometry_m")), _fmt(x.get("decision_mean_ms"), 2),
-                         _fmt(r.get("wall_s"), 1)])
-    _csv(study_dir / "runs.csv", ["env", "method", "seed", "ce", "nauc", "nauc_budget_m", "coverage", "distance_m",
-                                  "steps", "failed_moves", "stalls", "success", "rmse_odometry_m",
+        lv = x.get("at_level") or {}
+        csv_rows.append([s["env"], s["method"], s["seed"], r["key"], " ".join(str(v) for v in x["start_pose"]),
+                         x["trajectory_digest"], _fmt(lv.get("ce")), _fmt(lv.get("nauc")),
+                         _fmt(lv.get("distance_m"), 2), x.get("level_step"), _fmt(x["ce"]), _fmt(x["nauc"]),
+                         _fmt(x["nauc_budget_m"], 1),
+                         _fmt(x["coverage"]), _fmt(x["distance_m"], 2), x["steps"], x["ended_by_itself"],
+                         x["failed_moves"], ";".join(f"{e['cause']}@{e['step']}" for e in x["interventions"]),
+                         x["success"], _fmt(x.get("rmse_odometry_m")), _fmt(x.get("rmse_belief_m")),
+                         _fmt(x.get("decision_mean_ms"), 2), _fmt(r.get("wall_s"), 1)])
+    _csv(study_dir / "runs.csv", ["env", "method", "seed", "key", "start_pose", "trajectory_digest", "ce_at_level",
+                                  "nauc_at_level", "distance_at_level_m", "level_step", "ce_end", "nauc_end",
+                                  "nauc_budget_m", "coverage_end", "distance_end_m", "steps", "ended_by_itself",
+                                  "failed_moves", "interventions", "success", "rmse_odometry_m", "rmse_belief_m",
                                   "decision_mean_ms", "wall_s"], csv_rows)
     _csv(study_dir / "table.csv", header, rows)
     _exploration_figures(study_dir, plan, groups)
     budgets = {env: groups[(env, m)][0]["result"]["nauc_budget_m"] for env in plan["envs"] for m in plan["methods"]
                if (env, m) in groups}
-    note = ("nAUC over a distance budget of free area / 2 m per environment: "
-            + ", ".join(f"{e} {b:.0f} m" for e, b in budgets.items())
-            + f". Runs stop at {plan['stop_coverage']:.0%} coverage or the step budget "
-            + ", ".join(f"{e} {n}" for e, n in plan["steps"].items()) + ". Mean ± std over seeds "
-            + f"{plan['seeds']}. Paper: Tables 2 and 8 (Manual = human teleoperation; our oracle stands in).")
+    endpoint = (f"two per run. **At {pct} coverage**: the first decision at which LiDAR coverage >= {pct}; "
+                f"CE@{pct} = area covered then / distance travelled then (m²/m); nAUC@{pct} = nAUC over the budget "
+                f"of the coverage curve cut there (coverage held after it). **At the end** of the run: CE = area / "
+                "distance, nAUC over the budget with the last coverage held. nAUC budget = free area / 2 m: "
+                + ", ".join(f"{e} {b:.0f} m" for e, b in budgets.items())
+                + f". Columns marked (successful) average over successful runs only (the paper averages over five "
+                f"successful trials; runs that never reach {pct} have no CE@{pct}); (all) over every run that "
+                f"reached {pct}. Mean ± std (population) over runs.")
+    note = (protocol_note(plan, results, endpoint)
+            + "\n\nPaper: Tables 2 and 8, CE and nAUC over five successful trials as run (Manual = human "
+            "teleoperation; our oracle stands in; both frontier rows face the paper's Frontiers).")
     return _md(header, rows) + "\n\n" + note
 
 
 def _exploration_figures(study_dir: Path, plan, groups) -> None:
     plt = _plt()
     envs = plan["envs"]
+    level = plan.get("coverage_level", 0.9)
     fig, axes = plt.subplots(1, len(envs), figsize=(4.5 * len(envs), 3.6), squeeze=False)
-    colors = {"aimapp": "C0", "frontier": "C1", "random": "C2", "oracle": "C3"}
     for ax, env in zip(axes[0], envs, strict=True):
         for method in plan["methods"]:
             for i, r in enumerate(groups.get((env, method), [])):
                 c = r["result"]["curve"]
-                ax.step(c["distance"], c["coverage"], where="post", color=colors.get(method), alpha=0.7,
+                ax.step(c["distance"], c["coverage"], where="post", color=COLORS.get(method), alpha=0.7,
                         label=METHOD_LABEL[method] if i == 0 else None)
         rs = [r for m in plan["methods"] for r in groups.get((env, m), [])]
         if rs:
             ax.axvline(rs[0]["result"]["nauc_budget_m"], color="k", ls=":", lw=1)
+        ax.axhline(level, color="k", ls="--", lw=0.6)
         ax.set_title(env)
         ax.set_xlabel("distance travelled (m)")
         ax.set_ylim(0, 1.02)
     axes[0][0].set_ylabel("LiDAR coverage")
-    axes[0][0].legend(fontsize=8, loc="lower right")
+    axes[0][0].legend(fontsize=7, loc="lower right")
     fig.tight_layout()
     fig.savefig(study_dir / "coverage_curves.png", dpi=110)
     plt.close(fig)
 
-    fig, ax = plt.subplots(figsize=(1.8 + 1.6 * len(envs), 3.4))
+    fig, ax = plt.subplots(figsize=(2.6 + 1.6 * len(envs), 4.2))
     w = 0.8 / max(1, len(plan["methods"]))
     for j, method in enumerate(plan["methods"]):
         means, stds = [], []
         for env in envs:
-            s = summarise([r["result"]["ce"] for r in groups.get((env, method), [])])
+            s = summarise([_ep(r["result"], "lvl", "ce") for r in groups.get((env, method), [])
+                           if r["result"]["success"]])
             means.append(s["mean"] or 0.0)
             stds.append(s["std"] or 0.0)
-        ax.bar(np.arange(len(envs)) + j * w, means, w, yerr=stds, color=colors.get(method),
+        ax.bar(np.arange(len(envs)) + j * w, means, w, yerr=stds, color=COLORS.get(method),
                label=METHOD_LABEL[method], capsize=2)
     ax.set_xticks(np.arange(len(envs)) + w * (len(plan["methods"]) - 1) / 2)
     ax.set_xticklabels(envs, fontsize=8)
-    ax.set_ylabel("coverage efficiency (m²/m)")
-    ax.legend(fontsize=8)
+    ax.set_ylabel(f"CE at {level:.0%} coverage (m²/m)\nsuccessful runs")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, frameon=False)
     fig.tight_layout()
     fig.savefig(study_dir / "coverage_efficiency.png", dpi=110)
     plt.close(fig)
@@ -148,8 +243,10 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
 # ---------------------------------------------------------------------------- success
 def success_report(study_dir: Path, plan, results) -> str:
     groups = _groups(results, "env", "method")
-    header = ["Env.", "Method", "success rate", "stalls (interventions)", "failed moves", "paper success",
-              "paper interventions"]
+    counts, _ = distinct_check(results)
+    level = plan.get("coverage_level", 0.9)
+    header = ["Env.", "Method", "distinct runs", "success rate", "interventions stuck / collision / map",
+              "failed moves", f"reached {level:.0%}", "paper success", "paper interventions"]
     rows = []
     for env in plan["envs"]:
         for method in plan["methods"]:
@@ -159,14 +256,18 @@ def success_report(study_dir: Path, plan, results) -> str:
             pname = paper.PAPER_NAME.get(method)
             ps = paper.SUCCESS.get(env, {}).get(pname) if pname else None
             pi = paper.INTERVENTIONS.get(env, {}).get(pname) if pname else None
-            rows.append([env, METHOD_LABEL[method], f"{np.mean([r['success'] for r in rs]):.2f} ({len(rs)} runs)",
-                         sum(r["stalls"] for r in rs), sum(r["failed_moves"] for r in rs),
+            rows.append([env, METHOD_LABEL[method], counts.get((env, method, None), len(rs)),
+                         f"{np.mean([r['success'] for r in rs]):.2f} ({sum(r['success'] for r in rs)}/{len(rs)})",
+                         _causes(rs), sum(r["failed_moves"] for r in rs),
+                         f"{sum(r.get('at_level') is not None for r in rs)}/{len(rs)}",
                          "–" if ps is None else f"{ps:.2f}", "–" if pi is None else pi])
     _csv(study_dir / "table.csv", header, rows)
-    note = ("Success: final coverage >= {:.0%} with no stall (5 consecutive failed moves, or 25 decisions without "
-            "coverage gain below {:.0%} coverage). Paper: Table 3 (success = 5 / attempts) and Table 9 "
-            "(interventions); bedroom/parking/aisle rows stand in for the real home/parking/warehouse."
-            ).format(plan["success_coverage"], plan["stop_coverage"])
+    endpoint = ("the whole run (interventions are looked for over every decision); 'reached' counts runs whose "
+                f"coverage reached {level:.0%} at some point.")
+    note = (protocol_note(plan, results, endpoint)
+            + "\n\nPaper: Table 3 (success = 5 / attempts needed for five successful trials) and Table 9 "
+            "(interventions over those attempts); here each run is one attempt. Bedroom/parking/aisle rows stand in "
+            "for the real home/parking/warehouse.")
     return _md(header, rows) + "\n\n" + note
 
 
@@ -200,7 +301,10 @@ def goals_report(study_dir: Path, plan, results) -> str:
     ])
     _goal_figure(study_dir, reached)
     note = ("PLRs over reached goals; start known (localised at the exploration start). Paper Table 5's numbers "
-            "did not survive text extraction; the fractions are from section 4.4.")
+            "did not survive text extraction; the fractions are from section 4.4.\n\n"
+            + protocol_note(plan, results, "each goal pursuit ends when the goal is reached or after "
+                            f"{plan['params'].get('goal_steps')} decisions; the exploration before it ends by the run "
+                            "end rule below. PLRs over reached goals.", success=False))
     return _md(header, rows) + "\n\n" + extra + "\n\n" + note
 
 
@@ -224,24 +328,30 @@ def _goal_figure(study_dir, reached) -> None:
 # ---------------------------------------------------------------------------- drift
 def drift_report(study_dir: Path, plan, results) -> str:
     groups = _groups(results, "level", "method")
-    header = ["drift level", "Method", "RMSE belief (m)", "RMSE odometry (m)", "ATE/m belief", "ATE/m odometry",
-              "coverage"]
+    counts, _ = distinct_check(results)
+    env = plan["envs"][0] if plan["envs"] else None
+    header = ["drift level", "Method", "distinct runs", "success", "interventions stuck / collision / map",
+              "RMSE belief (m)", "RMSE odometry (m)", "ATE/m belief", "ATE/m odometry", "coverage"]
     rows = []
     for level in plan["params"]["levels"]:
         for method in plan["methods"]:
             rs = [r["result"] for r in groups.get((level, method), [])]
             if not rs:
                 continue
-            rows.append([level, METHOD_LABEL[method]] + [
+            rows.append([level, METHOD_LABEL[method], counts.get((env, method, level), len(rs)),
+                         f"{sum(r['success'] for r in rs)}/{len(rs)}", _causes(rs)] + [
                 _pm(summarise([r.get(k) for r in rs]), 3)
                 for k in ("rmse_belief_m", "rmse_odometry_m", "ate_per_m_belief", "ate_per_m_odometry", "coverage")])
     _csv(study_dir / "table.csv", header, rows)
     from .config import DRIFT_LEVELS
 
+    endpoint = ("the end of the run; RMSE and ATE/m over every decision of all runs (successful or not; the paper "
+                "averages five successful runs).")
     note = ("Levels (OdometryNoise): " + "; ".join(f"{k}: slip {v['slip']}, heading bias {v['heading_bias']} rad/m"
                                                    for k, v in DRIFT_LEVELS.items() if k in plan["params"]["levels"])
-            + f". Environment {plan['envs']}. Paper Table 4: {paper.DRIFT_NOTE}. Frontiers and the oracle have no "
-            "belief layer: their belief is odometry (frontier) or the true pose (oracle).")
+            + f". Environment {plan['envs']}. Paper Table 4: {paper.DRIFT_NOTE}. The frontier explorers and the "
+            "oracle have no belief layer: their belief is odometry (frontiers) or the true pose (oracle).\n\n"
+            + protocol_note(plan, results, endpoint))
     return _md(header, rows) + "\n\n" + note
 
 
@@ -283,7 +393,9 @@ def obstacle_report(study_dir: Path, plan, results) -> str:
     note = ("Figure 8 protocol: after exploring, the movable box is scheduled onto a free node the agent knows; "
             "we track the believed probabilities of the transitions from other states into that node "
             "(mean and max over those transitions). Paper: transitions into the blocked state are suppressed "
-            "over about twenty steps.")
+            "over about twenty steps.\n\n"
+            + protocol_note(plan, results, f"{plan['steps'].get(plan['envs'][0])} exploration decisions, then "
+                            f"{plan['params'].get('after_steps')} decisions after the box moves.", success=False))
     return _md(header, rows) + "\n\n" + note
 
 
@@ -321,7 +433,8 @@ def scaling_report(study_dir: Path, plan, results) -> str:
     _csv(study_dir / "table.csv", header, rows)
     size_rows = [[s["step"], s["num_states"], s["num_observations"], f"{s['model_bytes'] / 1024:.1f}"]
                  for s in sizes[-6:]]
-    note = "Decision time = AIMAPPAgent.step wall clock on this machine (2 shared cores), not a Jetson Orin Nano."
+    note = ("Decision time = AIMAPPAgent.step wall clock on this machine (2 shared cores), not a Jetson Orin Nano."
+            "\n\n" + protocol_note(plan, results, "every decision of each run (fixed budget).", success=False))
     return (_md(header, rows) + "\n\n" + _md(["step", "states", "observations", "model kB"], size_rows)
             + "\n\n" + note)
 

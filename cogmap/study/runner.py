@@ -36,6 +36,11 @@ def write_json_atomic(path: Path, data) -> None:
     os.replace(tmp, path)
 
 
+def same_spec(stored, spec: dict) -> bool:
+    """A stored run is reused only when its spec equals this one exactly (after a JSON round trip)."""
+    return stored == json.loads(json.dumps(spec))
+
+
 def load_runs(study_dir: Path) -> dict[str, dict]:
     out = {}
     for p in sorted((Path(study_dir) / "runs").glob("*.json")):
@@ -98,12 +103,15 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     study_dir = Path(out_dir) / name
     runs_dir = study_dir / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)
-    done = load_runs(study_dir)
+    stored = load_runs(study_dir)  # files of other scales or settings stay, but are never used here
+    done = {s["key"]: stored[s["key"]] for s in specs
+            if s["key"] in stored and same_spec(stored[s["key"]].get("spec"), s)}
     todo = [s for s in specs if s["key"] not in done]
+    missing = len(todo)
     if limit is not None:
         todo = todo[:limit]
     t0 = time.perf_counter()
-    bar = tqdm(total=len(specs), initial=len(specs) - len([s for s in specs if s["key"] not in done]),
+    bar = tqdm(total=len(specs), initial=len(specs) - missing,
                disable=not progress, desc=f"{name} runs", unit="run")
 
     def sink(res):
@@ -127,6 +135,8 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     complete = len(results) == len(specs)
     meta_path = study_dir / "study.json"
     prev = json.loads(meta_path.read_text()) if meta_path.exists() else {}
+    if not same_spec(prev.get("plan"), plan):  # another scale or setting in this directory: its sessions are not ours
+        prev = {}
     meta = {
         "study": name, "plan": plan, "seeds": plan["seeds"], "runs_total": len(specs), "runs_done": len(results),
         "complete": complete, "executor": executor, "workers": workers,
@@ -140,6 +150,11 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     write_json_atomic(meta_path, meta)
     summary = {"study_dir": str(study_dir), "complete": complete, "runs": len(results), "total": len(specs),
                "wall_s": elapsed}
+    from .report import distinct_check
+
+    summary["duplicates"] = distinct_check(results)[1]
+    if summary["duplicates"]:
+        print(f"ERROR: the same run appears twice in a row of the table: {summary['duplicates']}", file=sys.stderr)
     if report and results:
         from .report import write_report
 
@@ -171,6 +186,8 @@ def run_from_args(args) -> int:
         print(summary["table"])
     print(f"{summary['runs']}/{summary['total']} runs in {summary['study_dir']} "
           f"({summary['wall_s']:.0f} s this session)")
+    if summary["duplicates"]:
+        return 4
     return 0 if summary["complete"] else 3
 
 

@@ -13,13 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from .metrics_extra import (
-    count_stalls,
+    SuccessRule,
     drift_metrics,
+    endpoints,
     graph_plan_length,
-    is_success,
+    interventions,
     nauc_budget,
-    nauc_over_budget,
     path_length_ratios,
+    trajectory_digest,
     transitions_into,
 )
 
@@ -43,15 +44,13 @@ def _clean(x):
 
 def _noise(spec):
     from cogmap.envs import OdometryNoise
-    from cogmap.study.config import DRIFT_LEVELS
 
-    level = spec.get("level")
-    return OdometryNoise(**DRIFT_LEVELS[level]) if level else None
+    return OdometryNoise(**spec["noise"]) if spec.get("noise") else None
 
 
 def study_sim(env: str, cfg, seed: int, noise=None):
-    """A simulator whose start is ``layout.starts[seed % n]`` (see ``cogmap.explore.make_sim``):
-    consecutive seeds start from different places, as in the paper."""
+    """A simulator whose start is seed ``seed``'s own (``cogmap.starts.seed_start`` via
+    ``cogmap.explore.make_sim``): every seed starts somewhere else, as in the paper."""
     from cogmap.explore import make_sim
 
     return make_sim(env, cfg, seed, noise)
@@ -63,72 +62,98 @@ def _curve(ep, points: int = 120) -> dict:
     return {"distance": [round(float(v), 3) for v in d[idx]], "coverage": [round(float(v), 4) for v in c[idx]]}
 
 
-AIMAPP_PATIENCE = 20  # decisions without map growth or a first visit before AIMAPP ends (cogmap explore's default)
+def make_policy(method: str, sim, step: float, seed: int, config: dict | None = None):
+    """The baseline policy of ``method`` with the simulator's robot and LiDAR; ``config`` (the
+    spec's ``method_options["config"]``) overrides the config dataclass's defaults."""
+    from cogmap.baselines import (
+        FrontierConfig,
+        FrontierExplorer,
+        FrontierPaperConfig,
+        FrontierPaperExplorer,
+        OracleConfig,
+        OracleTour,
+        RandomWalk,
+    )
+
+    own = {**(config or {}), "step_length": step, "robot_radius": sim.config.robot_radius,
+           "lidar_range": sim.config.lidar_range}
+    if method == "frontier":
+        return FrontierExplorer(FrontierConfig(**own))
+    if method == "frontier_paper":
+        return FrontierPaperExplorer(FrontierPaperConfig(**own))
+    if method == "random":
+        return RandomWalk(step, seed=seed)
+    if method == "oracle":
+        return OracleTour(OracleConfig(**{k: v for k, v in own.items() if k in OracleConfig.__dataclass_fields__}))
+    raise ValueError(f"unknown method {method!r}")
 
 
-def explore_episode(env: str, method: str, seed: int, steps: int, stop_coverage: float | None, noise=None):
-    """Run one method in a fresh simulator; returns (sim, episode, agent-or-policy). Caller closes sim."""
+def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None,
+                    config: dict | None = None):
+    """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
+    ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim."""
     from cogmap.agent.aimapp import AIMAPPAgent
-    from cogmap.baselines import FrontierConfig, FrontierExplorer, OracleConfig, OracleTour, RandomWalk, run_policy
-    from cogmap.explore import Done, coverage_tracker, default_config, run_agent
+    from cogmap.baselines import run_policy
+    from cogmap.explore import Done, default_config, run_agent
+
+    from .config import AIMAPP_PATIENCE
 
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
-    step = cfg.influence_radius
     if method == "aimapp":
         agent = AIMAPPAgent(cfg, seed=seed)
-        done = Done(agent, AIMAPP_PATIENCE)  # the agent declares itself finished, as the baselines do
-
-        def stop(d):
-            finished = done(d)
-            return finished or (stop_coverage is not None and coverage_tracker(sim).coverage >= stop_coverage)
-
-        ep = run_agent(sim, agent, steps, progress=False, stop=stop)
-        return sim, ep, agent
-    if method == "frontier":
-        pol = FrontierExplorer(FrontierConfig(step_length=step, robot_radius=sim.config.robot_radius,
-                                              lidar_range=sim.config.lidar_range))
-    elif method == "random":
-        pol = RandomWalk(step, seed=seed)
-    elif method == "oracle":
-        pol = OracleTour(OracleConfig(step_length=step, robot_radius=sim.config.robot_radius,
-                                      lidar_range=sim.config.lidar_range))
-    else:
-        raise ValueError(f"unknown method {method!r}")
-    ep = run_policy(sim, pol, steps, stop_coverage=stop_coverage)
-    return sim, ep, pol
+        done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
+        ep = run_agent(sim, agent, steps, progress=False, stop=done)
+        return sim, ep, agent, bool(done.patience > 0 and done.quiet >= done.patience)
+    pol = make_policy(method, sim, cfg.influence_radius, seed, config)
+    ep = run_policy(sim, pol, steps)
+    return sim, ep, pol, bool(ep.rows and ep.rows[-1]["mode"] == "done")
 
 
-def exploration_result(spec, sim, ep) -> dict:
-    from cogmap.explore import episode_metrics
+def exploration_result(spec, sim, ep, ended_by_itself: bool = False) -> dict:
+    """Both endpoints (90 % coverage and end of run), interventions and success, drift, digest."""
+    from cogmap.explore import default_config, episode_metrics
 
     m = episode_metrics(sim, ep)
-    moved = [r["moved"] for r in ep.rows]
-    cov_rows = [r["coverage"] for r in ep.rows]
-    stalls = count_stalls(moved, cov_rows, target=spec["stop_coverage"])
+    rule = SuccessRule(**spec["success_rule"])
+    mismatch_m = rule.mismatch_m if rule.mismatch_m is not None else default_config(spec["env"]).influence_radius
     budget = nauc_budget(m["free_area_m2"])
     truth = [[r["true_x"], r["true_y"]] for r in ep.rows]
     odom = [[r["odom_x"], r["odom_y"]] for r in ep.rows]
     belief = [[r["belief_x"], r["belief_y"]] for r in ep.rows]
+    moved = [r["moved"] for r in ep.rows]
+    events = interventions(truth, moved, belief, rule, mismatch_m)
+    ends = endpoints(ep.distance, ep.coverage, m["free_area_m2"], budget, spec["coverage_level"])
     out = {
         "coverage": m["coverage"], "area_covered_m2": m["area_covered_m2"], "free_area_m2": m["free_area_m2"],
-        "distance_m": m["distance_m"], "steps": m["steps"], "ce": m["coverage_efficiency"],
-        "nauc": nauc_over_budget(ep.distance, ep.coverage, budget), "nauc_budget_m": budget,
-        "nauc_own_distance": m["nauc"], "failed_moves": m["failed_moves"], "stalls": stalls,
-        "success": is_success(m["coverage"], stalls, spec["success_coverage"]),
+        "distance_m": m["distance_m"], "steps": m["steps"], "ce": ends["end"]["ce"], "nauc": ends["end"]["nauc"],
+        "nauc_budget_m": budget, "nauc_own_distance": m["nauc"],
+        "at_level": ends["at_level"], "level_step": ends["level_index"], "ended_by_itself": ended_by_itself,
+        "failed_moves": m["failed_moves"], "interventions": events, "mismatch_m": mismatch_m,
+        "success": not events,
         "num_states": m["num_states"], "num_observations": m["num_observations"],
         "decision_mean_ms": m["decision_ms_mean"], "decision_p95_ms": m["decision_ms_p95"],
         **(drift_metrics(truth, odom, belief) if ep.rows else {}),
+        **_identity(sim, ep),
         "curve": _curve(ep),
     }
     return out
 
 
+def _identity(sim, ep) -> dict:
+    """Start pose and digest of the true trajectory (to prove that no run appears twice)."""
+    path = [[r["true_x"], r["true_y"]] for r in ep.rows] + [sim.true_pose()[:2].tolist()]
+    return {"start_pose": [round(float(v), 4) for v in sim.path[0]], "trajectory_digest": trajectory_digest(path)}
+
+
 def run_exploration(spec) -> dict:
-    sim, ep, _ = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], spec["stop_coverage"],
-                                 _noise(spec))
+    opts = spec["method_options"]
+    # AIMAPP runs with default_config(env), which is what its spec records; a baseline's recorded config is used
+    config = opts.get("config") if spec["method"] != "aimapp" else None
+    sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
+                                        opts.get("patience"), config)
     try:
-        return exploration_result(spec, sim, ep)
+        return exploration_result(spec, sim, ep, ended)
     finally:
         sim.close()
 
@@ -164,8 +189,10 @@ def run_goals(spec) -> dict:
     from cogmap.goal import pursue
 
     p = spec["params"]
-    sim, ep, agent = explore_episode(spec["env"], "aimapp", spec["seed"], spec["steps"], None)
+    sim, ep, agent, _ = explore_episode(spec["env"], "aimapp", spec["seed"], spec["steps"], None,
+                                        spec["method_options"].get("patience"))
     explore_cov = float(ep.coverage[-1])
+    ident = _identity(sim, ep)
     sim.close()
     cfg = default_config(spec["env"])
     base = copy.deepcopy(agent)
@@ -192,7 +219,7 @@ def run_goals(spec) -> dict:
         finally:
             sim.close()
     return {"explore_steps": len(ep.rows), "explore_coverage": explore_cov, "num_states": base.num_states,
-            "num_observations": int(base.model.num_obs[0]), "goals": results}
+            "num_observations": int(base.model.num_obs[0]), "goals": results, **ident}
 
 
 def run_obstacle(spec) -> dict:
@@ -234,7 +261,7 @@ def run_obstacle(spec) -> dict:
             if best is None or incoming > best[0]:
                 best = (incoming, s)
         if best is None:
-            return {"node": None, "trace": [], "note": "no free node to block"}
+            return {"node": None, "trace": [], "note": "no free node to block", **_identity(sim, ep)}
         node = best[1]
         target = agent.poses[node].copy()
         record("before")
@@ -243,7 +270,8 @@ def run_obstacle(spec) -> dict:
             run_agent(sim, agent, 1, progress=False, episode=ep)
             record("after")
         return {"node": int(node), "node_pose": target.tolist(), "moved_at_step": trace[0]["step"] + 1,
-                "trace": trace, "failed_moves": int(sum(1 for r in ep.rows if r["moved"] is False))}
+                "trace": trace, "failed_moves": int(sum(1 for r in ep.rows if r["moved"] is False)),
+                **_identity(sim, ep)}
     finally:
         sim.close()
 
@@ -293,7 +321,7 @@ def run_scaling(spec) -> dict:
         sizes.append({"step": agent.step_count, "num_states": agent.num_states,
                       "num_observations": int(agent.model.num_obs[0]), "model_bytes": model_size_bytes(agent.model)})
         return {"num_states": [int(v) for v in ep.num_states], "decision_ms": [round(v, 3) for v in ep.decision_ms],
-                "sizes": sizes, "coverage": float(ep.coverage[-1])}
+                "sizes": sizes, "coverage": float(ep.coverage[-1]), **_identity(sim, ep)}
     finally:
         sim.close()
 

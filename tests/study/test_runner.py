@@ -28,10 +28,76 @@ def test_specs_are_unique_and_cover_the_plan():
         study_plan("nope")
 
 
+def test_run_keys_change_with_every_setting_that_changes_a_run(monkeypatch):
+    tiny, reduced = run_specs(study_plan("exploration", "tiny")), run_specs(study_plan("exploration", "reduced"))
+    assert run_specs(study_plan("exploration", "tiny")) == tiny  # deterministic
+    shared = {(s["env"], s["method"], s["seed"]) for s in tiny}
+    red = {(s["env"], s["method"], s["seed"]): s["key"] for s in reduced}
+    assert shared <= set(red) and not {s["key"] for s in tiny} & set(red.values())
+    base = study_plan("exploration", "reduced", envs=["mini_warehouse"], seeds=[0], methods=["random"])
+    key = run_specs(base)[0]["key"]
+    for change in ({"steps": {"mini_warehouse": 41}}, {"scale": "full"}, {"coverage_level": 0.8},
+                   {"success_rule": {**base["success_rule"], "collision_run": 6}}, {"stop_rule": "budget"}):
+        assert run_specs({**base, **change})[0]["key"] != key, change
+    drift = run_specs(study_plan("drift", "reduced"))
+    assert len({s["key"] for s in drift}) == len(drift)
+    severe = [s for s in drift if s["level"] == "severe"]
+    assert all(s["noise"] == {"slip": 0.08, "heading_bias": 0.05} for s in severe)
+    from cogmap.study import config
+
+    monkeypatch.setitem(config.DRIFT_LEVELS, "severe", {"slip": 0.1, "heading_bias": 0.05})
+    assert not {s["key"] for s in severe} & {s["key"] for s in run_specs(study_plan("drift", "reduced"))}
+    monkeypatch.setitem(config.METHOD_OPTIONS, "random", {"note": "another option"})
+    assert run_specs(base)[0]["key"] != key
+    assert {s["method"] for s in drift} >= {"frontier", "frontier_paper"}
+    with pytest.raises(ValueError):
+        run_specs({**base, "methods": ["nope"]})
+
+
+def test_tiny_then_reduced_in_one_directory_does_not_mix(tmp_path):
+    kw = dict(envs=["mini_warehouse"], seeds=[0], methods=["random"], progress=False)
+    tiny = run_study("exploration", tmp_path, scale="tiny", **kw)
+    reduced = run_study("exploration", tmp_path, scale="reduced", **kw)
+    assert tiny["runs"] == reduced["runs"] == 1 and not reduced["duplicates"]
+    runs = load_runs(tmp_path / "exploration")
+    assert len(runs) == 2  # both stay on disk ...
+    assert sorted(r["result"]["steps"] for r in runs.values()) == [6, 40]
+    assert "mini_warehouse 6." in tiny["table"] and "mini_warehouse 40." in reduced["table"]  # ... each table its own
+    assert len(json.loads((tmp_path / "exploration" / "study.json").read_text())["sessions"]) == 1
+    csv = (tmp_path / "exploration" / "runs.csv").read_text().splitlines()
+    assert len(csv) == 2 and ",40," in csv[1]
+    # a stored run whose spec differs from the plan's (same key) is not reused
+    key = next(k for k, r in runs.items() if r["spec"]["scale"] == "reduced")
+    path = tmp_path / "exploration" / "runs" / f"{key}.json"
+    stored = json.loads(path.read_text())
+    stored["spec"]["steps"] = 39
+    path.write_text(json.dumps(stored))
+    run_study("exploration", tmp_path, scale="reduced", **kw)
+    assert json.loads(path.read_text())["spec"]["steps"] == 40
+
+
+def test_the_same_run_twice_in_a_row_is_reported_as_an_error():
+    from cogmap.study.report import distinct_check, protocol_note
+
+    plan = study_plan("exploration", "tiny")
+
+    def run(seed, method, digest):
+        return {"key": f"k{seed}{method}", "spec": {"env": "mini_warehouse", "method": method, "seed": seed},
+                "result": {"trajectory_digest": digest}}
+
+    results = [run(0, "aimapp", "a"), run(1, "aimapp", "a"), run(2, "aimapp", "b"), run(0, "frontier", "a")]
+    counts, dups = distinct_check(results)
+    assert counts == {("mini_warehouse", "aimapp", None): 2, ("mini_warehouse", "frontier", None): 1}
+    assert dups == [["k0aimapp", "k1aimapp"]]  # another method with the same path is another row
+    assert "ERROR" in protocol_note(plan, results, "end")
+    assert "ERROR" not in protocol_note(plan, results[1:], "end")
+
+
 def test_resumed_study_gives_the_same_table_as_an_uninterrupted_one(tmp_path):
     kw = dict(scale="tiny", methods=["aimapp", "frontier", "random"], progress=False)
     whole = run_study("exploration", tmp_path / "whole", **kw)
-    assert whole["complete"] and whole["runs"] == 6
+    assert whole["complete"] and whole["runs"] == 6 and whole["duplicates"] == []
+    assert "2 distinct run(s)" in whole["table"] and "ERROR" not in whole["table"]
     part = run_study("exploration", tmp_path / "part", limit=2, **kw)  # "interrupted" after two runs
     assert not part["complete"] and part["runs"] == 2
     runs_dir = tmp_path / "part" / "exploration" / "runs"
