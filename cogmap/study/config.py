@@ -8,7 +8,7 @@ import json
 
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
-STUDIES = ("exploration", "success", "goals", "drift", "obstacle", "scaling")
+STUDIES = ("exploration", "success", "goals", "drift", "dropout", "obstacle", "scaling")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 
 # How a run ends (the same rule for every study): AIMAPP by its own end of exploration
@@ -63,6 +63,9 @@ DRIFT_LEVELS = {
 }
 
 
+FAULTS = ("none", "lidar", "camera")  # dropout study: which stream is silent
+
+
 def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
     """Environments, methods, seeds and parameters of a study at a scale."""
     if study not in STUDIES:
@@ -93,6 +96,12 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         plan["seeds"] = list(range(5 if full else 2))
         plan["steps"] = {"aisle_warehouse": 300, "small_warehouse": 60}
         plan["params"] = {"levels": list(DRIFT_LEVELS) if full else ["none", "severe"]}
+    elif study == "dropout":  # section 4.3: sensor failure; one stream silent for a while mid-exploration
+        plan["envs"] = ["house" if full else "mini_warehouse"]
+        plan["methods"] = ["aimapp"]
+        plan["seeds"] = list(range(5 if full else 2))
+        plan["steps"] = {"house": 300, "mini_warehouse": 60}
+        plan["params"] = {"levels": list(FAULTS), "fault_start": 20 if full else 8, "fault_length": 30 if full else 10}
     elif study == "obstacle":
         plan["envs"] = ["mini_warehouse"]
         plan["methods"] = ["aimapp"]
@@ -113,6 +122,8 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
             plan["params"] = {**plan["params"], "goals_per_run": 1, "goal_steps": 5}
         if study == "obstacle":
             plan["params"] = {**plan["params"], "after_steps": 5}
+        if study == "dropout":
+            plan["params"] = {**plan["params"], "fault_start": 2, "fault_length": 2}
     if envs is not None:
         plan["envs"] = list(envs)
     if seeds is not None:
@@ -152,7 +163,7 @@ def run_specs(plan: dict) -> list[dict]:
                 for seed in plan["seeds"]:
                     spec = {
                         "study": plan["study"], "scale": plan["scale"], "env": env, "method": method,
-                        "seed": int(seed), "level": level, "noise": DRIFT_LEVELS[level] if level else None,
+                        "seed": int(seed), "level": level, "noise": DRIFT_LEVELS.get(level) if level else None,
                         "steps": plan["steps"][env], "stop_rule": plan["stop_rule"],
                         "coverage_level": plan["coverage_level"], "success_rule": plan["success_rule"],
                         "method_options": options, "params": plan["params"],

@@ -355,6 +355,45 @@ def drift_report(study_dir: Path, plan, results) -> str:
     return _md(header, rows) + "\n\n" + note
 
 
+# ---------------------------------------------------------------------------- dropout
+def dropout_report(study_dir: Path, plan, results) -> str:
+    """Final coverage with a stream silent mid-run, against the same seed without a fault."""
+    groups = _groups(results, "level", "method")
+    counts, _ = distinct_check(results)
+    env = plan["envs"][0] if plan["envs"] else None
+    p = plan["params"]
+    base = {r["spec"]["seed"]: r["result"]["coverage"] for r in results if r["spec"]["level"] == "none"}
+    header = ["silent stream", "Method", "distinct runs", "final coverage", "loss vs. no fault (points)",
+              "worst loss (points)", "decisions", "silent decisions", "ended by itself", "success"]
+    rows = []
+    for level in p["levels"]:
+        for method in plan["methods"]:
+            rs = [r for r in groups.get((level, method), [])]
+            if not rs:
+                continue
+            res = [r["result"] for r in rs]
+            loss = [100 * (base[r["spec"]["seed"]] - r["result"]["coverage"]) for r in rs
+                    if r["spec"]["seed"] in base]
+            rows.append([level, METHOD_LABEL[method], counts.get((env, method, level), len(rs)),
+                         _pm(summarise([x["coverage"] for x in res]), 3),
+                         _pm(summarise(loss), 1) if level != "none" else "–",
+                         f"{max(loss):.1f}" if loss and level != "none" else "–",
+                         _pm(summarise([x["steps"] for x in res]), 0),
+                         _pm(summarise([x.get("silent_decisions", 0) for x in res]), 0),
+                         f"{sum(bool(x['ended_by_itself']) for x in res)}/{len(res)}",
+                         f"{sum(bool(x['success']) for x in res)}/{len(res)}"])
+    _csv(study_dir / "table.csv", header, rows)
+    endpoint = ("the end of the run (the agent's own end or the budget); loss = coverage of the same seed without a "
+                "fault minus coverage with it, in percentage points (positive: the fault cost coverage).")
+    note = (f"Environment {plan['envs']}; the stream is silent for {p['fault_length']} decisions from decision "
+            f"{p['fault_start']}. Without the LiDAR the camera localises and the agent moves only along known "
+            "transitions (no expansion); without the camera odometry and the LiDAR move and map; decisions with a "
+            "silent stream do not count toward the end of exploration, and a silent LiDAR adds no coverage. Paper "
+            "(section 4.3): the agent resumed after camera, LiDAR or odometry restarts without re-initialisation "
+            "(no numbers).\n\n" + protocol_note(plan, results, endpoint))
+    return _md(header, rows) + "\n\n" + note
+
+
 # ---------------------------------------------------------------------------- obstacle
 def obstacle_report(study_dir: Path, plan, results) -> str:
     plt = _plt()
@@ -440,7 +479,7 @@ def scaling_report(study_dir: Path, plan, results) -> str:
 
 
 REPORTS = {"exploration": exploration_report, "success": success_report, "goals": goals_report,
-           "drift": drift_report, "obstacle": obstacle_report, "scaling": scaling_report}
+           "drift": drift_report, "dropout": dropout_report, "obstacle": obstacle_report, "scaling": scaling_report}
 
 
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:

@@ -89,7 +89,7 @@ def make_policy(method: str, sim, step: float, seed: int, config: dict | None = 
 
 
 def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None,
-                    config: dict | None = None):
+                    config: dict | None = None, faults=()):
     """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
     ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim."""
     from cogmap.agent.aimapp import AIMAPPAgent
@@ -100,6 +100,8 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
 
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
+    for stream, start, length in faults:  # (stream, first silent step, number of silent steps)
+        sim.inject_fault(stream, start, length)
     if method == "aimapp":
         agent = AIMAPPAgent(cfg, seed=seed)
         done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
@@ -154,6 +156,24 @@ def run_exploration(spec) -> dict:
                                         opts.get("patience"), config)
     try:
         return exploration_result(spec, sim, ep, ended)
+    finally:
+        sim.close()
+
+
+def run_dropout(spec) -> dict:
+    """Exploration with one stream ("lidar" or "camera") silent for ``fault_length`` decisions
+    from decision ``fault_start`` (level "none": no fault)."""
+    p = spec["params"]
+    faults = [] if spec["level"] == "none" else [(spec["level"], p["fault_start"], p["fault_length"])]
+    opts = spec["method_options"]
+    sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], None,
+                                        opts.get("patience"), None, faults)
+    try:
+        out = exploration_result(spec, sim, ep, ended)
+        out.pop("curve", None)
+        out["level"] = spec["level"]
+        out["silent_decisions"] = int(sum(1 for r in ep.rows if r.get("missing")))
+        return out
     finally:
         sim.close()
 
@@ -327,7 +347,7 @@ def run_scaling(spec) -> dict:
 
 
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
-           "obstacle": run_obstacle, "scaling": run_scaling}
+           "dropout": run_dropout, "obstacle": run_obstacle, "scaling": run_scaling}
 
 
 _DIGEST: str | None = None

@@ -133,3 +133,12 @@ def test_cli_entry_point(tmp_path, capsys):
     assert code == 0
     out = capsys.readouterr().out
     assert "Executed vs. A*" in out
+
+
+def test_dropout_study_pairs_each_fault_with_the_same_seed_without_one(tmp_path):
+    out = run_study("dropout", tmp_path, scale="tiny", seeds=[0], progress=False)
+    rows = {r["spec"]["level"]: r["result"] for r in load_runs(tmp_path / "dropout").values()}
+    assert set(rows) == {"none", "lidar", "camera"}
+    assert rows["none"]["silent_decisions"] == 0
+    assert rows["lidar"]["silent_decisions"] == rows["camera"]["silent_decisions"] == 2
+    assert "loss vs. no fault" in out["table"] and not out["duplicates"]
