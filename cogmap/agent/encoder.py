@@ -97,6 +97,19 @@ def shifted_ssim(a: np.ndarray, b: np.ndarray, shifts) -> np.ndarray:
     return np.array([ssim(np.roll(_gray(a), int(s), axis=1), b) for s in np.atleast_1d(shifts)])
 
 
+def best_shift(a: np.ndarray, b: np.ndarray, max_shift: int, refine: int = 3) -> tuple[int, float]:
+    """The column shift ``s`` (``|s| <= max_shift``) for which ``np.roll(a, s, axis=1)`` best
+    matches ``b``, and that SSIM: the ``refine`` shifts with the best row correlation
+    (:func:`column_shift_scores`) are scored by SSIM."""
+    x = _gray(a)
+    corr = column_shift_scores(x, b)
+    shifts = signed_shifts(max_shift, x.shape[1])
+    top = shifts[np.argsort(-corr[shifts % x.shape[1]], kind="stable")[:refine]]
+    scores = shifted_ssim(x, b, top)
+    k = int(np.argmax(scores))
+    return int(top[k]), float(scores[k])
+
+
 class SSIMEncoder:
     """Match panoramas by SSIM; unmatched panoramas become new observation ids.
 

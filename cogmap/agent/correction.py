@@ -1,0 +1,104 @@
+"""Drift correction by place recognition (section 3.3, Figure 6).
+
+The believed pose is the odometry pose mapped by a rigid transform ``frame`` (odometry frame ->
+belief frame, yaw + translation; :mod:`cogmap.inference.se2`). When a state is first visited
+confidently the agent keeps an :class:`Anchor`: where it believed it was, its panorama turned to
+the belief frame and its LiDAR returns in the belief frame. On a later confident visit of that
+state, :func:`relocalise` compares what is sensed now with the anchor:
+
+1. heading: the circular column shift that best aligns the panorama with the anchor's
+   (:func:`cogmap.agent.encoder.best_shift`, within ``max_shift`` columns) gives the heading
+   error of the belief frame (one column = 360 / width degrees);
+2. position: the scan is aligned with the anchor's scan by ICP started from that heading;
+3. recognition (observation evidence agrees with the state posterior): the shifted SSIM and the
+   fraction of LiDAR returns that the aligned scans share must pass thresholds, and the
+   correction must be small enough to be drift since the last correction.
+
+Thresholds (``AgentConfig``), chosen from ``python bench/relocalisation.py`` (aisle warehouse,
+random walk, moderate and severe study drift; quantiles 10/50/90 %):
+
+- shift-searched SSIM of revisits within 0.25 m: 0.48/0.60/0.68 (moderate), 0.49/0.66/0.76
+  (severe); of places 0.25-1 m apart 0.44-0.48 / 0.50-0.62 / 0.58-0.71; of places >= 3 m apart
+  0.43-0.45 / 0.49-0.51 / 0.56-0.66. SSIM alone cannot tell a drifted revisit from another place,
+  so it is only a gate: ``relocalise_align_ssim = 0.5`` drops about half of the wrong places.
+- ICP inlier fraction (returns within 0.1 m) of revisits within 0.5 m: median 0.85-0.93 (drift
+  within ICP's reach), of places >= 3 m apart: median 0.10-0.33 (90 %: 0.80-0.88, aisles alias
+  along their length), hence ``relocalise_inliers = 0.7`` plus a bound on the correction
+  (``relocalise_max_correction`` influence radii): a revisit has drifted by less than that since
+  the last correction, an aliased aisle place lies farther.
+- the column shift found for revisits within 0.25 m lies 2-3 columns (3-4 degrees) from the
+  true heading difference (median); ICP then fixes the position to about 0.02 m (median).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from cogmap.inference.se2 import SE2, about, apply, icp, wrap_angle
+
+from .encoder import best_shift
+
+
+@dataclass(frozen=True)
+class Anchor:
+    """What a state looked like at its first confident visit (belief frame)."""
+
+    pose: np.ndarray  # believed (x, y)
+    panorama: np.ndarray  # panorama turned to the belief frame
+    scan: np.ndarray  # LiDAR returns relative to the robot, belief-frame orientation (n, 2)
+    step: int
+
+
+@dataclass(frozen=True)
+class Relocalisation:
+    """Outcome of one comparison with an anchor; ``correction`` maps belief-frame points as they
+    were believed to where the anchor says they are."""
+
+    accepted: bool
+    correction: SE2
+    ssim: float
+    shift: int
+    inliers: float
+
+
+def panorama_columns(yaw: float, width: int) -> int:
+    """Columns to roll a 360-degree panorama whose reference heading is off by ``-yaw``
+    (views turning clockwise from the odometry heading): ``np.roll(p, panorama_columns(yaw, w),
+    axis=1)`` shows the panorama as seen from a frame turned by ``yaw``."""
+    return int(np.round(-wrap_angle(yaw) * width / (2 * np.pi)))
+
+
+def to_frame_panorama(panorama: np.ndarray, yaw: float) -> np.ndarray:
+    """The panorama as if rendered from a frame turned by ``yaw`` (odometry -> belief)."""
+    k = panorama_columns(yaw, np.shape(panorama)[1])
+    return panorama if k == 0 else np.roll(panorama, k, axis=1)
+
+
+def track(anchor: Anchor, scan: np.ndarray, pose: np.ndarray, *, min_inliers: float,
+          max_translation: float) -> Relocalisation:
+    """Scan-only comparison with the anchor of a nearby state (the one just left, about one
+    influence radius away, where panoramas no longer match but most LiDAR returns are shared):
+    ICP from the believed pose with a gate of ``max_translation``."""
+    pose = np.asarray(pose, dtype=float)[:2]
+    a = icp(pose + scan, anchor.pose + anchor.scan, None, max_distance=max_translation)
+    moved = float(np.hypot(*(apply(a.transform, pose) - pose)))
+    ok = a.inliers >= min_inliers and moved <= max_translation
+    return Relocalisation(bool(ok), a.transform, float("nan"), 0, a.inliers)
+
+
+def relocalise(anchor: Anchor, panorama: np.ndarray, scan: np.ndarray, pose: np.ndarray, *, max_shift: int,
+               min_ssim: float, min_inliers: float, max_translation: float) -> Relocalisation:
+    """Compare the current view (belief frame) with ``anchor``; see the module docstring."""
+    pose = np.asarray(pose, dtype=float)[:2]
+    width = np.shape(panorama)[1]
+    shift, score = best_shift(panorama, anchor.panorama, max_shift)
+    yaw = -2 * np.pi * shift / width  # roll(p, s) lines up: the belief heading is s columns off
+    init = about(yaw, pose, pose)
+    a = icp(pose + scan, anchor.pose + anchor.scan, init, max_distance=max_translation)
+    moved = float(np.hypot(*(apply(a.transform, pose) - pose)))
+    turned = abs(float(wrap_angle(a.transform.yaw)))
+    ok = (score >= min_ssim and a.inliers >= min_inliers and moved <= max_translation
+          and turned <= 2 * np.pi * (max_shift + 2) / width)
+    return Relocalisation(bool(ok), a.transform, score, shift, a.inliers)
