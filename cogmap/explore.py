@@ -11,7 +11,7 @@ from __future__ import annotations
 import csv
 import json
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -211,6 +211,8 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
     """The main job: explore ``env`` for at most ``steps`` decisions (ending early once the agent
     has nothing left to visit for ``patience`` decisions; 0 never ends early) and write the run
     directory."""
+    from cogmap.envs import OdometryNoise
+
     from .runs import write_manifest
 
     cfg = config or default_config(env)
@@ -220,7 +222,7 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
         if out is not None:
             out = Path(out)
             write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed, patience=patience,
-                           config=cfg.to_dict(), noise=None if noise is None else noise.__dict__)
+                           config=cfg.to_dict(), noise=asdict(noise or OdometryNoise()))
         done = Done(agent, patience)
         ep = run_agent(sim, agent, steps, progress, stop=done)
         metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.quiet >= patience > 0}

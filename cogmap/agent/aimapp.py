@@ -251,6 +251,9 @@ class AIMAPPAgent:
             return False
         if not r.accepted:
             return False
+        moved = float(np.hypot(*(apply(r.correction, pose) - pose)))
+        if moved < cfg.min_correction and abs(r.correction.yaw) < cfg.min_correction_yaw:
+            return False  # within the alignment's own error: keep the frame
         self.frame = compose(r.correction, self.frame)
         self.corrections += 1
         return True

@@ -41,6 +41,10 @@ class AgentConfig:
     track_anchors: bool = True  # at a first visit, align the scan with the anchor of the state just left
     track_inliers: float = 0.5  # fraction of shared LiDAR returns needed for that alignment
     track_max_correction: float = 0.25  # largest correction (influence radii) it may make
+    # corrections smaller than both (m, rad) are left out: scan alignment between places 1-2 m apart
+    # errs by about this much, so with exact odometry they would only add noise
+    min_correction: float = 0.1
+    min_correction_yaw: float = 0.035
     lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)
     learning: LearningRates = field(default_factory=LearningRates)
     initial_capacity: int = 64

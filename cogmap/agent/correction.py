@@ -8,7 +8,9 @@ state, :func:`relocalise` compares what is sensed now with the anchor:
 
 1. heading: the circular column shift that best aligns the panorama with the anchor's
    (:func:`cogmap.agent.encoder.best_shift`, within ``max_shift`` columns) gives the heading
-   error of the belief frame (one column = 360 / width degrees);
+   error of the belief frame (one column = 360 / width degrees on average: the four views are
+   pinhole images, so a roll matches a turn only approximately, SSIM about 0.8 after a 17 degree
+   turn is undone, 0.9 after 6 degrees);
 2. position: the scan is aligned with the anchor's scan by ICP started from that heading;
 3. recognition (observation evidence agrees with the state posterior): the shifted SSIM and the
    fraction of LiDAR returns that the aligned scans share must pass thresholds, and the
