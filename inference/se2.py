@@ -97,8 +97,8 @@ def icp(source, target, init: SE2 | None = None, iterations: int = 30, max_dista
     """Align 2-D point sets (e.g. two LiDAR scans) by trimmed point-to-point ICP from ``init``.
 
     Pairs farther apart than a gate are ignored; the gate shrinks from ``max_distance`` to
-    ``2 * tolerance`` over the iterations, so a coarse start can converge and the final fit uses
-    close pairs only."""
+    ``2 * tolerance`` over the first half of the iterations (it stops once the fit no longer
+    moves), so a coarse start can converge and the final fit uses close pairs only."""
     from scipy.spatial import cKDTree
 
     init = SE2() if init is None else init
@@ -107,13 +107,19 @@ def icp(source, target, init: SE2 | None = None, iterations: int = 30, max_dista
         return Alignment(init, 0.0, np.inf)
     tree = cKDTree(tgt)
     t = init
-    gates = np.geomspace(max(max_distance, 2 * tolerance), 2 * tolerance, iterations)
-    for gate in gates:
+    shrink = max(iterations // 2, 1)
+    gates = np.geomspace(max(max_distance, 2 * tolerance), 2 * tolerance, shrink)
+    for i in range(iterations):
+        gate = gates[min(i, shrink - 1)]
         d, k = tree.query(apply(t, src), distance_upper_bound=gate)
         ok = np.isfinite(d)
         if ok.sum() < 3:
             break
-        t = fit(src[ok], tgt[k[ok]])
+        new = fit(src[ok], tgt[k[ok]])
+        step = abs(new.yaw - t.yaw) + abs(new.x - t.x) + abs(new.y - t.y)
+        t = new
+        if i >= shrink - 1 and step < 1e-6:  # converged at the final gate
+            break
     d, _ = tree.query(apply(t, src))
     inside = d < tolerance
     rms = float(np.sqrt(np.mean(d[inside] ** 2))) if inside.any() else np.inf
