@@ -1,9 +1,10 @@
 """Run an AIMAPP agent in a pybullet room and write a run directory.
 
-The run directory holds ``run.json`` (config, seed, versions, commit), the model
-(``model.npz`` + ``model.json``), the cognitive map (``map.graphml``), the observations
-(``observations/*.png``), ``trajectory.csv`` (true pose, odometry, believed pose, state,
-action per step), ``metrics.json`` and the plots ``map.png`` and ``coverage.png``.
+The run directory holds ``run.json`` (config, seed, odometry noise, versions, commit), the model
+(``model.npz`` + ``model.json``), the places' anchors for drift correction (``anchors.npz``),
+the cognitive map (``map.graphml``), the observations (``observations/*.png``),
+``trajectory.csv`` (true pose, odometry, believed pose in the corrected frame, state, action per
+step), ``metrics.json`` and the plots ``map.png`` and ``coverage.png``.
 """
 
 from __future__ import annotations
@@ -168,6 +169,7 @@ def episode_metrics(sim, ep: Episode) -> dict:
 
 
 def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, title: str | None = None) -> None:
+    from cogmap.agent.correction import save_anchors
     from cogmap.genmodel.graph import write_graphml
     from cogmap.genmodel.io import save
 
@@ -175,6 +177,8 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
 
     out.mkdir(parents=True, exist_ok=True)
     save(agent.model, out / "model")
+    if agent.anchors:  # views and scans that drift correction compares with (cogmap.agent.correction)
+        save_anchors(out / "anchors.npz", agent.anchors)
     write_graphml(agent.model, out / "map.graphml")
     obs_dir = out / "observations"
     obs_dir.mkdir(exist_ok=True)

@@ -104,3 +104,25 @@ def relocalise(anchor: Anchor, panorama: np.ndarray, scan: np.ndarray, pose: np.
     ok = (score >= min_ssim and a.inliers >= min_inliers and moved <= max_translation
           and turned <= 2 * np.pi * (max_shift + 2) / width)
     return Relocalisation(bool(ok), a.transform, score, shift, a.inliers)
+
+
+def save_anchors(path, anchors: dict[int, Anchor]) -> None:
+    """Write anchors to one compressed ``.npz`` (arrays only, no pickle)."""
+    states = np.array(sorted(anchors), dtype=int)
+    items = [anchors[int(s)] for s in states]
+    scans = [np.asarray(a.scan, dtype=float).reshape(-1, 2) for a in items]
+    np.savez_compressed(
+        path, states=states, poses=np.array([a.pose for a in items], dtype=float).reshape(-1, 2),
+        steps=np.array([a.step for a in items], dtype=int),
+        panoramas=np.array([a.panorama for a in items]) if items else np.zeros((0, 1, 1)),
+        scans=np.concatenate(scans) if scans else np.zeros((0, 2)),
+        offsets=np.cumsum([0] + [len(s) for s in scans]))
+
+
+def load_anchors(path) -> dict[int, Anchor]:
+    """Anchors written by :func:`save_anchors`."""
+    with np.load(path, allow_pickle=False) as f:
+        off = f["offsets"]
+        return {int(s): Anchor(f["poses"][i].copy(), f["panoramas"][i].copy(), f["scans"][off[i]:off[i + 1]].copy(),
+                               int(f["steps"][i]))
+                for i, s in enumerate(f["states"])}

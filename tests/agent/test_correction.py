@@ -57,6 +57,22 @@ def test_fit_and_icp_recover_a_known_rotation():
     assert icp(walls[:2], noisy).inliers == 0.0  # too few points: no alignment
 
 
+def test_anchors_round_trip_through_npz(tmp_path):
+    from cogmap.agent.correction import Anchor, load_anchors, save_anchors
+
+    rng = np.random.default_rng(3)
+    anchors = {s: Anchor(rng.normal(size=2), rng.integers(0, 255, (4, 16, 3), dtype=np.uint8),
+                         rng.normal(size=(n, 2)), s * 2) for s, n in ((0, 5), (3, 0), (7, 9))}
+    save_anchors(tmp_path / "a.npz", anchors)
+    back = load_anchors(tmp_path / "a.npz")
+    assert sorted(back) == [0, 3, 7]
+    for s, a in anchors.items():
+        np.testing.assert_array_equal(back[s].pose, a.pose)
+        np.testing.assert_array_equal(back[s].panorama, a.panorama)
+        np.testing.assert_array_equal(back[s].scan, a.scan)
+        assert back[s].step == a.step
+
+
 def test_column_shift_of_a_rolled_image_is_found():
     rng = np.random.default_rng(2)
     import cv2
@@ -151,5 +167,14 @@ def test_explore_command_line_drift_flags_are_recorded(tmp_path):
                  "--heading-bias", "0.02"]) == 0
     noise = json.loads((out / "run.json").read_text())["noise"]
     assert noise["slip"] == 0.1 and noise["heading_bias"] == 0.02
+    from cogmap.goal import load_agent
+
+    agent, _ = load_agent(out)  # the places' anchors come back with the model
+    assert agent.anchors and max(agent.anchors) < agent.num_states
+    for a in agent.anchors.values():
+        assert a.pose.shape == (2,) and a.scan.ndim == 2 and a.scan.shape[1] == 2 and a.panorama.ndim == 3
+    # a goal run in the same drifting conditions, with the loaded anchors
+    assert main(["goal", "--run", str(out), "--goal-obs", "0", "--steps", "3", "--quiet"]) in (0, 1)
+    assert (out / "goal" / "trajectory.csv").exists()
     with pytest.raises(SystemExit):
         main(["explore", "--slip", "fast"])
