@@ -22,7 +22,7 @@ from cogmap.agent.config import AgentConfig
 from cogmap.metrics import CoverageTracker, coverage_efficiency, nauc, rmse
 
 TRAJ_FIELDS = [
-    "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y",
+    "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y", "belief_yaw",
     "state", "action", "mode", "moved", "num_states", "num_obs", "coverage", "distance", "decision_ms",
 ]
 
@@ -114,7 +114,7 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
         d = agent.step(sensed)
         ms = 1e3 * (time.perf_counter() - t0)
         true, odom = sim.true_pose(), sensed.odometry
-        belief = agent.believed_pose(odom) if odom is not None else np.full(2, np.nan)
+        belief = agent.believed_pose_yaw(odom) if odom is not None else np.full(3, np.nan)
         ep.coverage.append(tracker.coverage)
         ep.distance.append(dist)
         ep.decision_ms.append(ms)
@@ -122,7 +122,8 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
         odom = np.full(3, np.nan) if odom is None else odom
         ep.rows.append(dict(
             step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
-            odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], state=d.state, action=d.action,
+            odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], belief_yaw=belief[2],
+            state=d.state, action=d.action,
             mode=d.mode, moved=moved, num_states=agent.num_states,
             num_obs=0 if agent.model is None else agent.model.num_obs[0], coverage=tracker.coverage,
             distance=dist, decision_ms=ms,

@@ -57,6 +57,27 @@ def test_fit_and_icp_recover_a_known_rotation():
     assert icp(walls[:2], noisy).inliers == 0.0  # too few points: no alignment
 
 
+def test_agent_belief_frame_turns_poses_waypoints_scan_obstacles_and_panorama():
+    from cogmap.agent.aimapp import AIMAPPAgent, Sensed
+    from cogmap.agent.config import AgentConfig
+
+    agent = AIMAPPAgent(AgentConfig())
+    agent.frame = SE2(np.pi / 2, 1.0, 2.0)
+    odom = np.array([3.0, -1.0, 0.2])
+    np.testing.assert_allclose(agent.believed_pose(odom), [2.0, 5.0], atol=1e-12)  # R(90) (3, -1) + (1, 2)
+    np.testing.assert_allclose(agent.believed_pose_yaw(odom)[2], 0.2 + np.pi / 2)
+    np.testing.assert_allclose(agent.to_odometry(agent.believed_pose(odom)), odom[:2], atol=1e-12)
+    # one LiDAR return 0.8 m ahead along the odometry x axis is, in the belief frame, along +y (heading 3)
+    flags = np.zeros(12, dtype=bool)
+    flags[0] = True
+    pano = np.arange(64 * 256).reshape(64, 256)
+    local = agent._to_belief(Sensed(pano, flags, odom, None, np.array([[0.8, 0.0]])))
+    np.testing.assert_allclose(local.scan, [[0.0, 0.8]], atol=1e-12)
+    assert np.flatnonzero(local.obstacles).tolist() == [3]
+    np.testing.assert_array_equal(local.panorama, np.roll(pano, -64, axis=1))  # a quarter turn = 64 columns
+    assert np.flatnonzero(agent._to_belief(Sensed(pano, flags, odom)).obstacles).tolist() == [3]  # no scan
+
+
 def test_anchors_round_trip_through_npz(tmp_path):
     from cogmap.agent.correction import Anchor, load_anchors, save_anchors
 
