@@ -12,9 +12,10 @@ quantiles (10 / 50 / 90 %) of:
 - ``true-shift``: SSIM after rolling by the true heading difference (what position alone costs);
 
 and, for revisits (< 1 m), how far the shift found lies from the true heading difference.
-Then the LiDAR scans of each pair are aligned (``inference.se2.icp``, started from the
-panorama's heading estimate): the fraction of returns within 0.1 m of the other scan
-(``icp inliers``) and, for pairs whose odometry disagrees by at most 1.5 m (what ICP must
+Then, for pairs whose heading difference lies within the search (the agent corrects its
+heading often enough to stay there), the LiDAR scans are aligned (``inference.se2.icp``,
+started from the panorama's heading estimate): the fraction of returns within 0.1 m of the
+other scan (``icp inliers``) and, for those pairs whose odometry disagrees by at most 1.5 m (what ICP must
 bridge after the agent's last correction), the error of the corrected position (m).
 The agent's recognition thresholds (``AgentConfig.relocalise_ssim``) are chosen from these numbers.
 
@@ -119,6 +120,8 @@ def main(argv=None) -> None:
                                odom[i, :2] + np_rot(err[i]) @ (true[j, :2] - true[i, :2]))
                 init = about(-s * col, odom[j, :2], odom[j, :2])
                 a = icp(odom[j, :2] + scans[j], odom[i, :2] + scans[i], init, max_distance=1.5)
+                if abs(s_true) > args.max_shift:
+                    continue  # heading apart beyond the search: the agent corrects before that
                 inl.append(a.inliers)
                 if np.hypot(*(apply(c_true, odom[j, :2]) - odom[j, :2])) <= 1.5:
                     perr.append(float(np.hypot(*(apply(a.transform, odom[j, :2]) - apply(c_true, odom[j, :2])))))
@@ -127,7 +130,7 @@ def main(argv=None) -> None:
             label = f"{lo:.2f}-{hi:.2f}" if np.isfinite(hi) else f">= {lo:.1f}"
             extra = q(serr[inside]) if hi <= 1.0 else "     -    "
             print(f"{label:>18} {len(raw):>6} {q(raw):>16} {q(found):>16} {q(oracle):>16} {q(tshift):>18}"
-                  f" {extra:>19} {q(inl):>16} {q(perr) if hi <= 1.0 else '-':>16} ({len(perr)})")
+                  f" {extra:>19} {q(inl):>16} {q(perr) if hi <= 1.0 else '-':>16} ({len(inl)}, {len(perr)})")
 
 
 if __name__ == "__main__":
