@@ -20,7 +20,7 @@ Revisits alone leave the map made between them as drifted as the odometry was (F
 internally consistent, physically off). At a first visit, :func:`track` therefore aligns the
 scan with the anchor of the state just left (one step away, still in LiDAR view), so new anchors
 are laid down in a corrected frame. The paper names such a geometric back-end as future work
-(section 6); ``AgentConfig(track_anchors=False)`` keeps only the paper's revisit correction.
+(section 5.1); ``AgentConfig(track_anchors=False)`` keeps only the paper's revisit correction.
 Measured in the aisle warehouse, 5 seeds, study protocol: revisits only reduce the ATE/m from
 0.073 to 0.060 (moderate) and 0.102 to 0.073 (severe); with tracking the belief ATE/m is 0.001-0.004.
 
