@@ -10,11 +10,13 @@ from pathlib import Path
 
 
 def _explore(args) -> int:
+    from .envs import OdometryNoise
     from .explore import explore
 
     out = Path(args.out)
+    noise = OdometryNoise(slip=args.slip, heading_bias=args.heading_bias)
     metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
-                      patience=args.patience)
+                      patience=args.patience, noise=noise)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
     return 0
@@ -62,6 +64,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="end once the map has not grown and no state was visited for the first time in this "
                         "many decisions (default: 20; 0: always run --steps)")
     e.add_argument("--seed", type=int, default=0)
+    e.add_argument("--slip", type=float, default=0.0,
+                   help="odometry drift: fractional over-read of travelled distance (default: 0; 0.05 reads 1.05 m "
+                        "per metre)")
+    e.add_argument("--heading-bias", type=float, default=0.0,
+                   help="odometry drift: yaw error in rad per metre travelled (default: 0)")
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=_explore)

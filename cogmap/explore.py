@@ -1,9 +1,10 @@
 """Run an AIMAPP agent in a pybullet room and write a run directory.
 
-The run directory holds ``run.json`` (config, seed, versions, commit), the model
-(``model.npz`` + ``model.json``), the cognitive map (``map.graphml``), the observations
-(``observations/*.png``), ``trajectory.csv`` (true pose, odometry, believed pose, state,
-action per step), ``metrics.json`` and the plots ``map.png`` and ``coverage.png``.
+The run directory holds ``run.json`` (config, seed, odometry noise, versions, commit), the model
+(``model.npz`` + ``model.json``), the places' anchors for drift correction (``anchors.npz``),
+the cognitive map (``map.graphml``), the observations (``observations/*.png``),
+``trajectory.csv`` (true pose, odometry, believed pose in the corrected frame, state, action per
+step), ``metrics.json`` and the plots ``map.png`` and ``coverage.png``.
 """
 
 from __future__ import annotations
@@ -11,7 +12,7 @@ from __future__ import annotations
 import csv
 import json
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -21,7 +22,7 @@ from cogmap.agent.config import AgentConfig
 from cogmap.metrics import CoverageTracker, coverage_efficiency, nauc, rmse
 
 TRAJ_FIELDS = [
-    "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y",
+    "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y", "belief_yaw",
     "state", "action", "mode", "missing", "moved", "num_states", "num_obs", "coverage", "distance", "decision_ms",
 ]
 
@@ -117,7 +118,7 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
         d = agent.step(sensed)
         ms = 1e3 * (time.perf_counter() - t0)
         true, odom = sim.true_pose(), sensed.odometry
-        belief = agent.believed_pose(odom) if odom is not None else np.full(2, np.nan)
+        belief = agent.believed_pose_yaw(odom) if odom is not None else np.full(3, np.nan)
         ep.coverage.append(tracker.coverage)
         ep.distance.append(dist)
         ep.decision_ms.append(ms)
@@ -125,8 +126,9 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
         odom = np.full(3, np.nan) if odom is None else odom
         ep.rows.append(dict(
             step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
-            odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], state=d.state, action=d.action,
-            mode=d.mode, missing="+".join(d.missing), moved=moved, num_states=agent.num_states,
+            odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], belief_yaw=belief[2],
+            state=d.state, action=d.action, mode=d.mode, missing="+".join(d.missing), moved=moved,
+            num_states=agent.num_states,
             num_obs=0 if agent.model is None else agent.model.num_obs[0], coverage=tracker.coverage,
             distance=dist, decision_ms=ms,
         ))
@@ -174,6 +176,7 @@ def episode_metrics(sim, ep: Episode) -> dict:
 
 
 def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, title: str | None = None) -> None:
+    from cogmap.agent.correction import save_anchors
     from cogmap.genmodel.graph import write_graphml
     from cogmap.genmodel.io import save
 
@@ -181,6 +184,8 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
 
     out.mkdir(parents=True, exist_ok=True)
     save(agent.model, out / "model")
+    if agent.anchors:  # views and scans that drift correction compares with (cogmap.agent.correction)
+        save_anchors(out / "anchors.npz", agent.anchors)
     write_graphml(agent.model, out / "map.graphml")
     obs_dir = out / "observations"
     obs_dir.mkdir(exist_ok=True)
@@ -222,6 +227,8 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
     """The main job: explore ``env`` for at most ``steps`` decisions (ending early once the agent
     has nothing left to visit for ``patience`` decisions; 0 never ends early) and write the run
     directory."""
+    from cogmap.envs import OdometryNoise
+
     from .runs import write_manifest
 
     cfg = config or default_config(env)
@@ -231,7 +238,7 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
         if out is not None:
             out = Path(out)
             write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed, patience=patience,
-                           config=cfg.to_dict(), noise=None if noise is None else noise.__dict__)
+                           config=cfg.to_dict(), noise=asdict(noise or OdometryNoise()))
         done = Done(agent, patience)
         ep = run_agent(sim, agent, steps, progress, stop=done)
         metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.quiet >= patience > 0}

@@ -15,6 +15,7 @@ import numpy as np
 
 from cogmap.agent.aimapp import AIMAPPAgent
 from cogmap.agent.config import AgentConfig
+from cogmap.agent.correction import load_anchors
 from cogmap.agent.encoder import SSIMEncoder
 
 from .explore import episode_metrics, make_sim, run_agent, write_run
@@ -45,7 +46,10 @@ def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
     model = load(run / "model")
     if len(encoder) != model.num_obs[0]:
         raise ValueError(f"{run}: {len(encoder)} observation images for {model.num_obs[0]} model outcomes")
-    return AIMAPPAgent(cfg, encoder=encoder, seed=seed, model=model), manifest
+    agent = AIMAPPAgent(cfg, encoder=encoder, seed=seed, model=model)
+    if (run / "anchors.npz").exists():
+        agent.anchors = load_anchors(run / "anchors.npz")
+    return agent, manifest
 
 
 def goal_observation(agent: AIMAPPAgent, image: np.ndarray) -> int:
@@ -89,7 +93,10 @@ def reach_goal(run: Path, goal_image: str | None = None, goal_obs: int | None = 
         if img is None:
             raise ValueError(f"cannot read goal image {goal_image}")
         goal_obs = goal_observation(agent, cv2.cvtColor(img, cv2.COLOR_BGR2RGB))
-    sim = make_sim(manifest["env"], agent.cfg, manifest["seed"])
+    from cogmap.envs import OdometryNoise
+
+    noise = OdometryNoise(**manifest["noise"]) if manifest.get("noise") else None  # same drift as the exploration
+    sim = make_sim(manifest["env"], agent.cfg, manifest["seed"], noise)
     try:
         agent.localise_at(sim.odometry())
         out = Path(out) if out is not None else Path(run) / "goal"

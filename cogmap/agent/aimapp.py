@@ -3,11 +3,14 @@
 Each :meth:`AIMAPPAgent.step` runs sense -> infer -> learn -> plan and returns where to go:
 
 1. *sense* (``_observe``): the panorama becomes an observation id through the encoder (a new id
-   grows A_o); the believed pose is odometry plus the correction of the last re-localisation.
+   grows A_o); the believed pose is the odometry pose mapped by ``frame``, the rigid transform
+   (yaw + translation) of the last re-localisation; panorama, LiDAR returns and obstacle flags
+   are turned into that belief frame (``_to_belief``), and waypoints back to odometry.
 2. *infer* (``_infer``): the single-factor filter combines the B_s prediction of the last move
    with A_o and A_p evidence; the confidence test scores the result (``confidence.py``).
 3. *learn* (``_update``): when confident, A_o ties the observation to the believed state, a
-   near-identical view re-localises the metric pose, the executed or failed move updates B_s
+   recognised place corrects the pose drift (``correction.py``: panorama shift for the heading,
+   LiDAR alignment with the place's anchor for the position), the executed or failed move updates B_s
    with the Table 7 rates, the obstacle signal adds predicted (im)possible transitions, and free
    directions where no state lies yet expand the map when Eq. (7) says so. When unsure between
    nearby states only A_o learns, under the posterior. When the lost test fires, nothing is
@@ -32,10 +35,12 @@ import numpy as np
 from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseB, compile
 from cogmap.inference import bayes_filter
 from cogmap.inference.learning import Event, learn_observation, learn_transition
+from cogmap.inference.se2 import SE2, apply, apply_pose, compose, invert, rotate
 
 from . import planner
 from .confidence import Confidence, assess
 from .config import AgentConfig
+from .correction import Anchor, relocalise, to_frame_panorama, track
 from .encoder import Encoder, SSIMEncoder
 from .mapping import direction, expansion_free_energies, reverse_heading
 from .sensing import blocked
@@ -50,6 +55,7 @@ class Sensed:
     odometry: np.ndarray | None  # (x, y, yaw) in the odometry frame
     moved: bool | None = None  # outcome of the last motion command (None: no command)
     scan: np.ndarray | None = None  # optional LiDAR returns relative to the robot (odometry frame, (n, 2))
+    # the agent turns panorama, obstacles and scan into its belief frame before using them
 
     @property
     def missing(self) -> tuple[str, ...]:
@@ -102,7 +108,9 @@ class AIMAPPAgent:
         self.rng = np.random.default_rng(seed)
         self.model = model
         self.q: np.ndarray | None = None
-        self.offset = np.zeros(2)  # believed pose = odometry + offset
+        self.frame = SE2()  # odometry frame -> belief frame (drift correction, section 3.3)
+        self.anchors: dict[int, Anchor] = {}  # state -> view and scan of its first confident visit
+        self.corrections = 0  # accepted drift corrections
         self.last: Decision | None = None
         self.goal_obs: int | None = None
         self.step_count = 0
@@ -122,8 +130,26 @@ class AIMAPPAgent:
     def poses(self) -> np.ndarray:
         return self.model.pose.poses[: self.num_states]
 
+    @property
+    def offset(self) -> np.ndarray:
+        """Translation part of the odometry -> belief transform."""
+        return self.frame.t
+
     def believed_pose(self, odometry) -> np.ndarray:
-        return np.asarray(odometry, dtype=float)[:2] + self.offset
+        """Believed (x, y) of an odometry pose (``frame`` applied)."""
+        return apply(self.frame, np.asarray(odometry, dtype=float)[:2])
+
+    def believed_pose_yaw(self, odometry) -> np.ndarray:
+        """Believed (x, y, yaw) of an odometry pose (x, y, yaw)."""
+        return apply_pose(self.frame, odometry)
+
+    def to_odometry(self, xy) -> np.ndarray:
+        """A belief-frame point in the odometry frame (where the simulator drives)."""
+        return apply(invert(self.frame), xy)
+
+    def _shift_frame(self, delta) -> None:
+        """Translate the belief frame by ``delta`` (belief-frame metres)."""
+        self.frame = compose(SE2(0.0, float(delta[0]), float(delta[1])), self.frame)
 
     @property
     def at_goal(self) -> bool:
@@ -138,7 +164,7 @@ class AIMAPPAgent:
         s = int(np.argmin(d))
         self.q = np.zeros(self.num_states)
         self.q[s] = 1.0
-        self.offset += self.poses[s] - self.believed_pose(odometry)
+        self._shift_frame(self.poses[s] - self.believed_pose(odometry))
         self.last, self._outcome = None, None
         return s
 
@@ -171,10 +197,14 @@ class AIMAPPAgent:
         if self.model is None:
             self.model = initial_model(self.cfg, pose)
             self.q = np.ones(1)
-        obs, score = self._observe(sensed.panorama) if sensed.panorama is not None else (None, 0.0)
+        local = self._to_belief(sensed)
+        obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
         q, conf = self._infer(obs, pose)
-        expanded = self._update(q, conf, obs, sensed, pose, score)
-        decision = self._decide(sensed, pose, conf, expanded)
+        if self._correct(q, conf, local, pose):  # a recognised place moved the belief frame
+            pose = self.believed_pose(sensed.odometry)
+            local = self._to_belief(sensed)
+        expanded = self._update(q, conf, obs, local, pose, score)
+        decision = self._decide(local, pose, conf, expanded)
         decision.missing = missing
         self.last, self._outcome = decision, None
         return decision
@@ -186,6 +216,63 @@ class AIMAPPAgent:
         state = -1 if self.last is None else self.last.state
         here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
         return Decision(self.cfg.stay, here, state, state, "paused", missing=sensed.missing)
+
+    def _to_belief(self, sensed: Sensed) -> Sensed:
+        """``sensed`` in the belief frame: panorama turned (images only), LiDAR returns rotated
+        and the per-heading obstacle flags recomputed from them (or, without a scan, taken from
+        the nearest odometry heading)."""
+        yaw = self.frame.yaw
+        if yaw == 0.0:
+            return sensed
+        cfg = self.cfg
+        pano = sensed.panorama
+        if pano is not None and np.ndim(pano) >= 2:
+            pano = to_frame_panorama(pano, yaw)
+        scan = None if sensed.scan is None else rotate(self.frame, sensed.scan)
+        if scan is not None:
+            h = 2 * np.pi * np.arange(cfg.num_headings) / cfg.num_headings
+            moves = cfg.influence_radius * np.stack([np.cos(h), np.sin(h)], axis=1)
+            obstacles = blocked(scan, moves, cfg.robot_radius + cfg.obstacle_margin)
+        elif sensed.obstacles is not None:
+            k = int(np.round(yaw * cfg.num_headings / (2 * np.pi)))
+            obstacles = np.roll(np.asarray(sensed.obstacles, dtype=bool), k)
+        else:  # the LiDAR is silent
+            obstacles = None
+        return Sensed(pano, obstacles, sensed.odometry, sensed.moved, scan)
+
+    def _correct(self, q: np.ndarray, conf: Confidence, local: Sensed, pose: np.ndarray) -> bool:
+        """Drift correction (section 3.3): when the posterior confidently names a state that has
+        an anchor and the view and scan recognise it (``correction.relocalise``), the belief
+        frame is corrected by a rigid transform. Returns whether it was."""
+        cfg = self.cfg
+        if self.lost or not conf.confident or local.scan is None:
+            return False
+        state = int(np.argmax(q))
+        last = self.last
+        if last is not None and last.state == state:
+            return False  # compare once per arrival
+        reach = cfg.relocalise_max_correction * cfg.influence_radius
+        anchor = self.anchors.get(state)
+        if anchor is not None and np.ndim(local.panorama) >= 2:  # a revisit: the place's own view and scan
+            if np.hypot(*(pose - anchor.pose)) > cfg.influence_radius + reach:
+                return False
+            r = relocalise(anchor, np.asarray(local.panorama), local.scan, pose,
+                           max_shift=cfg.relocalise_max_shift, min_ssim=cfg.relocalise_align_ssim,
+                           min_inliers=cfg.relocalise_inliers, max_translation=reach)
+        elif anchor is None and cfg.track_anchors and last is not None and last.state in self.anchors:
+            # a first visit: the scan of the place just left is still in view
+            r = track(self.anchors[last.state], local.scan, pose, min_inliers=cfg.track_inliers,
+                      max_translation=cfg.track_max_correction * cfg.influence_radius)
+        else:
+            return False
+        if not r.accepted:
+            return False
+        moved = float(np.hypot(*(apply(r.correction, pose) - pose)))
+        if moved < cfg.min_correction and abs(r.correction.yaw) < cfg.min_correction_yaw:
+            return False  # within the alignment's own error: keep the frame
+        self.frame = compose(r.correction, self.frame)
+        self.corrections += 1
+        return True
 
     def _observe(self, panorama) -> tuple[int, float]:
         """Observation id (a new id grows A_o) and the encoder's best similarity score."""
@@ -224,7 +311,7 @@ class AIMAPPAgent:
             # a familiar view singles out a place
             if obs is not None and q[state] >= 0.5 and self._recognised(state, obs):
                 self.lost, self.lost_evidence = False, 0.0
-                self.offset += self.poses[state] - pose  # found again: trust the map's pose
+                self._shift_frame(self.poses[state] - pose)  # found again: trust the map's pose
                 self.relocalisations += 1
         elif conf.lost(cfg.z_threshold):
             self.lost, self.lost_evidence = True, 0.0
@@ -247,16 +334,16 @@ class AIMAPPAgent:
             # The map position is unknown, so the graph cannot guide a move: step in a free
             # direction of the real surroundings until a familiar view is recognised.
             if sensed.obstacles is None:  # nothing says which way is free: wait for the LiDAR
-                return Decision(cfg.stay, pose - self.offset, state, state, "relocalise", conf, expanded)
+                return Decision(cfg.stay, self.to_odometry(pose), state, state, "relocalise", conf, expanded)
             free = np.flatnonzero(~np.asarray(sensed.obstacles, dtype=bool))
             action = int(self.rng.choice(free)) if free.size else cfg.stay
             waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
-            return Decision(action, waypoint - self.offset, state, state, "relocalise", conf, expanded)
+            return Decision(action, self.to_odometry(waypoint), state, state, "relocalise", conf, expanded)
         mode = "goal" if self.goal_obs is not None else "explore"
         flags = self._move_obstacles(state, sensed.obstacles, sensed.scan, pose)
         action, efe = planner.decide(self, state, flags, mode)
         target, waypoint = self._waypoint(state, action)
-        return Decision(action, waypoint - self.offset, state, target, mode, conf, expanded, efe)
+        return Decision(action, self.to_odometry(waypoint), state, target, mode, conf, expanded, efe)
 
     # -- pieces ------------------------------------------------------------------------------
     def _prior(self, moved: bool | None) -> np.ndarray:
@@ -299,9 +386,12 @@ class AIMAPPAgent:
         if obs is not None:
             onehot = np.zeros(self.num_states)
             onehot[state] = 1.0
-            if self._recognised(state, obs) and score >= cfg.relocalise_ssim:
-                # a familiar view, nearly identical: re-localise the metric pose on it (drift correction)
-                self.offset += self.poses[state] - pose
+            if sensed.scan is None and self._recognised(state, obs) and score >= cfg.relocalise_ssim:
+                # no LiDAR to align: a familiar, nearly identical view re-localises onto the state's pose
+                self._shift_frame(self.poses[state] - pose)
+            elif state not in self.anchors and sensed.scan is not None and np.ndim(sensed.panorama) >= 2:
+                self.anchors[state] = Anchor(pose.copy(), np.asarray(sensed.panorama).copy(), sensed.scan.copy(),
+                                             self.step_count)
             learn_observation(m, 0, obs, [onehot], lr=cfg.obs_learning_rate)
         last = self.last
         arrived = last is None or state != last.state

@@ -31,7 +31,20 @@ class AgentConfig:
     collision_preference: float = -6.0  # log-preference of a collision outcome
     prior_count: float = 0.1  # Dirichlet mass of a new column (A_o: spread over the outcomes; B_s: on staying)
     obs_learning_rate: float = 4.0  # counts added when an observation is tied to a state
-    relocalise_ssim: float = 0.9  # a recognised view this similar (about 0.1 m away) re-localises the pose
+    relocalise_ssim: float = 0.9  # without LiDAR: a recognised view this similar re-localises onto its state
+    # drift correction by place recognition with panorama + LiDAR (thresholds from
+    # bench/relocalisation.py, see cogmap.agent.correction)
+    relocalise_align_ssim: float = 0.5  # shift-searched SSIM against the state's anchor view
+    relocalise_inliers: float = 0.7  # fraction of LiDAR returns the aligned scans share (within 0.1 m)
+    relocalise_max_shift: int = 32  # columns searched (45 degrees on a 256-column panorama)
+    relocalise_max_correction: float = 0.75  # largest accepted position correction, in influence radii
+    track_anchors: bool = True  # at a first visit, align the scan with the anchor of the state just left
+    track_inliers: float = 0.5  # fraction of shared LiDAR returns needed for that alignment
+    track_max_correction: float = 0.25  # largest correction (influence radii) it may make
+    # corrections smaller than both (m, rad) are left out: scan alignment between places 1-2 m apart
+    # errs by about this much, so with exact odometry they would only add noise
+    min_correction: float = 0.1
+    min_correction_yaw: float = 0.035
     lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)
     learning: LearningRates = field(default_factory=LearningRates)
     initial_capacity: int = 64

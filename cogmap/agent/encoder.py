@@ -66,6 +66,50 @@ def ssim(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.mean(num / den))
 
 
+def column_shift_scores(a: np.ndarray, b: np.ndarray, rows: int = 16) -> np.ndarray:
+    """Normalised correlation of ``np.roll(a, s, axis=1)`` with ``b`` for every column shift
+    ``s`` (index ``s`` of the result, ``0 <= s < width``), for 360-degree panoramas.
+
+    Both images are reduced to ``rows`` grey rows (area average) with each row's mean removed;
+    the circular cross-correlation of the rows is summed (one FFT per image), so every shift
+    costs nothing extra. Used to shortlist the shifts worth an SSIM."""
+    x, y = _gray(a), _gray(b)
+    if x.shape != y.shape:
+        raise ValueError(f"images of shapes {x.shape} and {y.shape} differ")
+    w = x.shape[1]
+    x = _cv2().resize(x, (w, rows), interpolation=_cv2().INTER_AREA).astype(float)
+    y = _cv2().resize(y, (w, rows), interpolation=_cv2().INTER_AREA).astype(float)
+    x -= x.mean(axis=1, keepdims=True)
+    y -= y.mean(axis=1, keepdims=True)
+    # r[s] = sum_c x[c - s] y[c] = correlation of roll(x, s) with y
+    r = np.fft.irfft(np.fft.rfft(y, axis=1) * np.conj(np.fft.rfft(x, axis=1)), n=w, axis=1).sum(axis=0)
+    return r / max(float(np.linalg.norm(x) * np.linalg.norm(y)), 1e-9)
+
+
+def signed_shifts(max_shift: int, width: int) -> np.ndarray:
+    """Column shifts ``-max_shift .. max_shift`` (clipped to half the width)."""
+    m = min(int(max_shift), width // 2)
+    return np.arange(-m, m + 1)
+
+
+def shifted_ssim(a: np.ndarray, b: np.ndarray, shifts) -> np.ndarray:
+    """SSIM of ``np.roll(a, s, axis=1)`` with ``b`` for each shift ``s`` (exhaustive reference)."""
+    return np.array([ssim(np.roll(_gray(a), int(s), axis=1), b) for s in np.atleast_1d(shifts)])
+
+
+def best_shift(a: np.ndarray, b: np.ndarray, max_shift: int, refine: int = 3) -> tuple[int, float]:
+    """The column shift ``s`` (``|s| <= max_shift``) for which ``np.roll(a, s, axis=1)`` best
+    matches ``b``, and that SSIM: the ``refine`` shifts with the best row correlation
+    (:func:`column_shift_scores`) are scored by SSIM."""
+    x = _gray(a)
+    corr = column_shift_scores(x, b)
+    shifts = signed_shifts(max_shift, x.shape[1])
+    top = shifts[np.argsort(-corr[shifts % x.shape[1]], kind="stable")[:refine]]
+    scores = shifted_ssim(x, b, top)
+    k = int(np.argmax(scores))
+    return int(top[k]), float(scores[k])
+
+
 class SSIMEncoder:
     """Match panoramas by SSIM; unmatched panoramas become new observation ids.
 
@@ -136,6 +180,26 @@ class SSIMEncoder:
             den = ((mx * mx)[None] + self._mu2c1[sel]) * (vx[None] + self._varc2[sel])
             out[a : a + sel.size] = (num / den).mean(axis=(1, 2))
         return out
+
+    def align(self, image: np.ndarray, ids, max_shift: int, refine: int = 3) -> tuple[int, int, float]:
+        """Best match of ``image`` among stored ``ids`` allowing a circular column shift of up to
+        ``max_shift`` columns: returns ``(id, shift, ssim)`` where ``np.roll(image, shift, axis=1)``
+        is what matched (``(-1, 0, 0.0)`` for no ids).
+
+        Per stored image, the ``refine`` shifts with the best row correlation
+        (:func:`column_shift_scores`) are scored by SSIM; a heading error of the panorama's
+        reference direction shows up as such a shift (one column = 360 / width degrees)."""
+        x = _gray(image)
+        best = (-1, 0, 0.0)
+        for k in np.atleast_1d(np.asarray(ids, dtype=int)):
+            corr = column_shift_scores(x, self._x[k])
+            shifts = signed_shifts(max_shift, x.shape[1])
+            top = shifts[np.argsort(-corr[shifts % x.shape[1]], kind="stable")[:refine]]
+            for s in top:
+                score = float(self.scores(np.roll(x, int(s), axis=1), [k])[0])
+                if score > best[2]:
+                    best = (int(k), int(s), score)
+        return best
 
     def candidates(self, image: np.ndarray) -> np.ndarray:
         """Stored ids worth an SSIM: all, or the ``shortlist`` best by thumbnail correlation."""
