@@ -10,6 +10,9 @@ from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
 STUDIES = ("exploration", "success", "goals", "drift", "dropout", "obstacle", "scaling")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
+# AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
+# scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
+AIMAPP_VARIANTS = {"aimapp_revisits": {"track_anchors": False}}
 
 # How a run ends (the same rule for every study): AIMAPP by its own end of exploration
 # (cogmap.explore.Done: no map growth and no first visit for AIMAPP_PATIENCE decisions), a
@@ -23,11 +26,21 @@ AIMAPP_PATIENCE = 20
 # options of each method that change its runs (part of every run's key); see method_options()
 METHOD_OPTIONS = {
     "aimapp": {"patience": AIMAPP_PATIENCE},
+    "aimapp_revisits": {"patience": AIMAPP_PATIENCE},
     "frontier": {"goal": "nearest reachable cell"},
     "frontier_paper": {"goal": "centroid"},
     "random": {},
     "oracle": {},
 }
+
+
+def aimapp_config(method: str, env: str):
+    """The ``AgentConfig`` an AIMAPP method runs with in ``env``."""
+    from dataclasses import replace
+
+    from cogmap.explore import default_config
+
+    return replace(default_config(env), **AIMAPP_VARIANTS.get(method, {}))
 
 
 def method_options(method: str, env: str) -> dict:
@@ -41,7 +54,9 @@ def method_options(method: str, env: str) -> dict:
 
     if method not in METHOD_OPTIONS:
         raise ValueError(f"unknown method {method!r}; choose from {list(METHOD_OPTIONS)}")
-    config = {"aimapp": lambda: default_config(env).to_dict(), "frontier": lambda: asdict(FrontierConfig()),
+    config = {"aimapp": lambda: default_config(env).to_dict(),
+              "aimapp_revisits": lambda: aimapp_config("aimapp_revisits", env).to_dict(),
+              "frontier": lambda: asdict(FrontierConfig()),
               "frontier_paper": lambda: asdict(FrontierPaperConfig()), "oracle": lambda: asdict(OracleConfig()),
               "random": dict}[method]()
     return json.loads(json.dumps({**METHOD_OPTIONS[method], "config": config}))
@@ -92,7 +107,7 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         plan["params"] = {"goals_per_run": 2, "goal_steps": 60, "min_goal_distance": 1.5}
     elif study == "drift":
         plan["envs"] = ["aisle_warehouse" if full else "small_warehouse"]
-        plan["methods"] = ["aimapp", "frontier", "frontier_paper", "oracle"]
+        plan["methods"] = ["aimapp", "aimapp_revisits", "frontier", "frontier_paper", "oracle"]
         plan["seeds"] = list(range(5 if full else 2))
         plan["steps"] = {"aisle_warehouse": 300, "small_warehouse": 60}
         plan["params"] = {"levels": list(DRIFT_LEVELS) if full else ["none", "severe"]}

@@ -102,8 +102,10 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
     sim = study_sim(env, cfg, seed, noise)
     for stream, start, length in faults:  # (stream, first silent step, number of silent steps)
         sim.inject_fault(stream, start, length)
-    if method == "aimapp":
-        agent = AIMAPPAgent(cfg, seed=seed)
+    if method.startswith("aimapp"):
+        from .config import aimapp_config
+
+        agent = AIMAPPAgent(aimapp_config(method, env), seed=seed)
         done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
         ep = run_agent(sim, agent, steps, progress=False, stop=done)
         return sim, ep, agent, bool(done.patience > 0 and done.quiet >= done.patience)
@@ -151,7 +153,7 @@ def _identity(sim, ep) -> dict:
 def run_exploration(spec) -> dict:
     opts = spec["method_options"]
     # AIMAPP runs with default_config(env), which is what its spec records; a baseline's recorded config is used
-    config = opts.get("config") if spec["method"] != "aimapp" else None
+    config = opts.get("config") if not spec["method"].startswith("aimapp") else None
     sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
                                         opts.get("patience"), config)
     try:
