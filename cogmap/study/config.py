@@ -8,7 +8,7 @@ import json
 
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
-STUDIES = ("exploration", "success", "goals", "drift", "dropout", "obstacle", "scaling")
+STUDIES = ("exploration", "success", "goals", "drift", "slip", "dropout", "obstacle", "scaling")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -75,6 +75,7 @@ DRIFT_LEVELS = {
     "none": {"slip": 0.0, "heading_bias": 0.0},
     "moderate": {"slip": 0.03, "heading_bias": 0.02},
     "severe": {"slip": 0.08, "heading_bias": 0.05},
+    "slip15": {"slip": 0.15, "heading_bias": 0.0},  # wheel slip on a slippery floor (slip study)
 }
 
 
@@ -111,6 +112,12 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         plan["seeds"] = list(range(5 if full else 2))
         plan["steps"] = {"aisle_warehouse": 300, "small_warehouse": 60}
         plan["params"] = {"levels": list(DRIFT_LEVELS) if full else ["none", "severe"]}
+    elif study == "slip":  # exploration of the house under 15 % wheel slip (section 4.3: drift-inducing floors)
+        plan["envs"] = ["house" if full else "small_warehouse"]
+        plan["methods"] = ["aimapp", "aimapp_revisits", "frontier"]
+        plan["seeds"] = list(range(5 if full else 2))
+        plan["steps"] = {"house": 300, "small_warehouse": 60}
+        plan["params"] = {"levels": ["none", "slip15"]}
     elif study == "dropout":  # section 4.3: sensor failure; one stream silent for a while mid-exploration
         plan["envs"] = ["house" if full else "mini_warehouse"]
         plan["methods"] = ["aimapp"]

@@ -333,7 +333,8 @@ def drift_report(study_dir: Path, plan, results) -> str:
     counts, _ = distinct_check(results)
     env = plan["envs"][0] if plan["envs"] else None
     header = ["drift level", "Method", "distinct runs", "success", "interventions stuck / collision / map",
-              "RMSE belief (m)", "RMSE odometry (m)", "ATE/m belief", "ATE/m odometry", "coverage"]
+              "RMSE belief (m)", "RMSE odometry (m)", "ATE/m belief", "ATE/m odometry", "coverage",
+              f"coverage >= {plan.get('coverage_level', 0.9):.0%}"]
     rows = []
     for level in plan["params"]["levels"]:
         for method in plan["methods"]:
@@ -343,7 +344,8 @@ def drift_report(study_dir: Path, plan, results) -> str:
             rows.append([level, METHOD_LABEL[method], counts.get((env, method, level), len(rs)),
                          f"{sum(r['success'] for r in rs)}/{len(rs)}", _causes(rs)] + [
                 _pm(summarise([r.get(k) for r in rs]), 3)
-                for k in ("rmse_belief_m", "rmse_odometry_m", "ate_per_m_belief", "ate_per_m_odometry", "coverage")])
+                for k in ("rmse_belief_m", "rmse_odometry_m", "ate_per_m_belief", "ate_per_m_odometry", "coverage")]
+                + [f"{sum(r['coverage'] >= plan.get('coverage_level', 0.9) for r in rs)}/{len(rs)}"])
     _csv(study_dir / "table.csv", header, rows)
     from .config import DRIFT_LEVELS
 
@@ -486,7 +488,7 @@ def scaling_report(study_dir: Path, plan, results) -> str:
 
 
 REPORTS = {"exploration": exploration_report, "success": success_report, "goals": goals_report,
-           "drift": drift_report, "dropout": dropout_report, "obstacle": obstacle_report, "scaling": scaling_report}
+           "drift": drift_report, "slip": drift_report, "dropout": dropout_report, "obstacle": obstacle_report, "scaling": scaling_report}
 
 
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:

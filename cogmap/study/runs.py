@@ -349,7 +349,7 @@ def run_scaling(spec) -> dict:
 
 
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
-           "dropout": run_dropout, "obstacle": run_obstacle, "scaling": run_scaling}
+           "slip": run_drift, "dropout": run_dropout, "obstacle": run_obstacle, "scaling": run_scaling}
 
 
 _DIGEST: str | None = None
