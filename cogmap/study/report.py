@@ -488,7 +488,8 @@ def scaling_report(study_dir: Path, plan, results) -> str:
 
 
 REPORTS = {"exploration": exploration_report, "success": success_report, "goals": goals_report,
-           "drift": drift_report, "slip": drift_report, "dropout": dropout_report, "obstacle": obstacle_report, "scaling": scaling_report}
+           "drift": drift_report, "slip": drift_report, "dropout": dropout_report,
+           "obstacle": obstacle_report, "scaling": scaling_report}
 
 
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
