@@ -38,7 +38,7 @@ from cogmap.inference.learning import Event, learn_observation, learn_transition
 from cogmap.inference.se2 import SE2, apply, apply_pose, compose, invert, rotate
 
 from . import planner
-from .confidence import Confidence, assess
+from .confidence import Confidence, assess, cusum
 from .config import AgentConfig
 from .correction import Anchor, relocalise, to_frame_panorama, track
 from .encoder import Encoder, SSIMEncoder
@@ -307,11 +307,16 @@ class AIMAPPAgent:
         cfg = self.cfg
         state = int(np.argmax(q))
         expanded = 0
+        if not self.lost and conf.conflict > cfg.lost_slack and self._scan_agrees(sensed, pose):
+            # the view points elsewhere but the LiDAR matches the place the belief is at: aliasing
+            # (repeated racks, similar rooms), not a wrong position; it adds no evidence of being lost
+            evidence = cusum(self.lost_evidence, 0.0, cfg.lost_slack)
+            conf = conf._replace(conflict=0.0, lost_evidence=evidence, confident=conf.dominance >= cfg.z_threshold)
         if self.lost:
-            # a familiar view singles out a place
-            if obs is not None and q[state] >= 0.5 and self._recognised(state, obs):
+            # a familiar view singles out a place (and, with a LiDAR, the scan confirms it)
+            if obs is not None and q[state] >= 0.5 and self._recognised(state, obs) and self._found_at(
+                    state, sensed, pose):
                 self.lost, self.lost_evidence = False, 0.0
-                self._shift_frame(self.poses[state] - pose)  # found again: trust the map's pose
                 self.relocalisations += 1
         elif conf.lost(cfg.z_threshold):
             self.lost, self.lost_evidence = True, 0.0
@@ -370,6 +375,40 @@ class AIMAPPAgent:
     def visited(self) -> np.ndarray:
         """Mask of states whose observation model has been taught (the agent has been there)."""
         return self.model.live_pA(0).max(axis=0) > 2 * self.cfg.prior_count
+
+    def _scan_agrees(self, sensed: Sensed, pose: np.ndarray) -> bool:
+        """The LiDAR scan aligns, within the tracking gate, with the anchor of the nearest
+        anchored state around the believed pose (False without a scan or an anchor nearby)."""
+        cfg = self.cfg
+        if sensed.scan is None or not self.anchors:
+            return False
+        states = np.fromiter(self.anchors, dtype=int)
+        d = np.hypot(*(self.poses[states] - pose).T)
+        k = int(np.argmin(d))
+        if d[k] > 1.5 * cfg.influence_radius:
+            return False
+        r = track(self.anchors[int(states[k])], sensed.scan, pose, min_inliers=cfg.relocalise_inliers,
+                  max_translation=cfg.track_max_correction * cfg.influence_radius)
+        return r.accepted
+
+    def _found_at(self, state: int, sensed: Sensed, pose: np.ndarray) -> bool:
+        """Re-localise on ``state`` after being lost; returns whether the belief frame moved.
+        With the state's anchor and a scan, the view (heading) and the scan (position) must
+        align with it, as in :func:`correction.relocalise` from the anchor's pose; otherwise the
+        belief moves onto the state's stored pose."""
+        cfg = self.cfg
+        anchor = self.anchors.get(state)
+        if anchor is None or sensed.scan is None or np.ndim(sensed.panorama) < 2:
+            self._shift_frame(self.poses[state] - pose)  # trust the map's pose
+            return True
+        r = relocalise(anchor, np.asarray(sensed.panorama), sensed.scan, anchor.pose,
+                       max_shift=cfg.relocalise_max_shift, min_ssim=cfg.relocalise_align_ssim,
+                       min_inliers=cfg.relocalise_inliers, max_translation=cfg.influence_radius)
+        if not r.accepted:
+            return False
+        # move the believed pose onto the anchor's, then apply the alignment found from there
+        self.frame = compose(compose(r.correction, SE2(0.0, *(anchor.pose - pose))), self.frame)
+        return True
 
     def _recognised(self, state: int, obs: int) -> bool:
         """``obs`` has been tied to ``state`` before and to no other state as strongly."""
