@@ -35,6 +35,7 @@ from .config import AgentConfig
 from .encoder import Encoder, SSIMEncoder
 from .mapping import direction, expansion_free_energies, reverse_heading
 from .sensing import blocked
+from .viewmap import ViewMap
 
 
 @dataclass
@@ -101,6 +102,7 @@ class AIMAPPAgent:
         self.lost_events = 0
         self.last_obs: int | None = None
         self.relocalisations = 0
+        self.views = ViewMap(self.cfg)  # what the LiDAR has sensed (exploration planning only)
 
     # -- public ------------------------------------------------------------------------------
     @property
@@ -233,6 +235,7 @@ class AIMAPPAgent:
             action = int(self.rng.choice(free)) if free.size else cfg.stay
             waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
             return Decision(action, waypoint - self.offset, state, state, "relocalise", conf, expanded)
+        self.views.observe(self, sensed)  # exploration hook: the scan, in the belief frame
         mode = "goal" if self.goal_obs is not None else "explore"
         flags = self._move_obstacles(state, sensed.obstacles, sensed.scan, pose)
         action, efe = planner.decide(self, state, flags, mode)

@@ -1,0 +1,102 @@
+"""What the agent's LiDAR has already sensed, in the belief frame, and what each state's view
+would still reveal (the stateful side of ``cogmap.planning.sensed``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cogmap.planning import sensed as sg
+
+
+class ViewMap:
+    """Owns the sensed grid and a per-state cache of unseen view areas.
+
+    Unseen areas only shrink as scans accumulate (cells go from unknown to free or occupied),
+    so a state whose area fell below ``min_area`` is never queried again; each decision queries
+    the states that still promise something and the new ones.
+    """
+
+    def __init__(self, cfg):
+        self.cfg = cfg
+        self.grid: sg.SensedGrid | None = None
+        self.area = np.zeros(0)  # unseen area (m2) per state; NaN: not computed yet
+        self.target = -1  # state pursued by the inductive term (kept while nearly the best)
+        self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
+
+    def observe(self, agent, sensed) -> None:
+        """Add the scan of ``sensed`` (points relative to the robot, odometry frame) to the grid,
+        through the agent's own odometry -> belief mapping."""
+        scan = sensed.scan
+        if scan is None or sensed.odometry is None:
+            return
+        odom = np.asarray(sensed.odometry, dtype=float)
+        robot = agent.believed_pose(odom)
+        # the agent's odometry -> belief mapping, read at two unit offsets (exact for any affine,
+        # e.g. rigid, correction), applied to the returns
+        ex = agent.believed_pose(odom + np.r_[1.0, 0.0, np.zeros(odom.size - 2)]) - robot
+        ey = agent.believed_pose(odom + np.r_[0.0, 1.0, np.zeros(odom.size - 2)]) - robot
+        rel = np.asarray(scan, dtype=float).reshape(-1, 2)
+        pts = robot + rel[:, :1] * ex + rel[:, 1:] * ey
+        if self.grid is None:
+            self.grid = sg.empty(robot, self.cfg.view_resolution)
+        self.grid = sg.mark_scan(self.grid, robot, pts)
+
+    def areas(self, poses: np.ndarray, visited: np.ndarray) -> np.ndarray | None:
+        """Unseen view area (m2) of every state (``poses`` (n, 2)); None before any scan. A state
+        the robot has stood on (``visited``) has been seen from: whatever its imagined view still
+        misses is not visible from there (as for the oracle's viewpoints)."""
+        if self.grid is None:
+            return None
+        n = len(poses)
+        if self.area.size < n:
+            self.area = np.concatenate([self.area, np.full(n - self.area.size, np.nan)])
+        self.area[:n][np.asarray(visited[:n], dtype=bool)] = 0.0
+        stale = np.flatnonzero(~(self.area[:n] < self.cfg.view_min_area))  # NaN or still informative
+        if stale.size:
+            self.area[stale] = sg.unseen_area(self.grid, poses[stale], self.cfg.view_radius, self.cfg.view_rays)
+        return self.area[:n]
+
+    def candidates(self, poses: np.ndarray, visited: np.ndarray,
+                   areas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """States that still promise information, how much (m2), and how far (m) beyond the
+        state the view that promises it lies: the states whose own view would reveal at least
+        ``view_min_area`` (0 m beyond), and the unvisited states nearest (along sensed free
+        space) to a frontier point whose view would reveal ``view_frontier_area``, that no
+        visited state stands near (what is left unseen there is not visible from close by), within
+        ``view_frontier_reach`` (the map grows from that state toward the frontier)."""
+        cfg = self.cfg
+        visited = np.asarray(visited[: len(poses)], dtype=bool)
+        states = np.flatnonzero(areas >= cfg.view_min_area)
+        gains, beyond = areas[states], np.zeros(states.size)
+        open_ = np.flatnonzero(~visited)
+        if self.grid is None or open_.size == 0:
+            return states, gains, beyond
+        pts = sg.frontier_points(self.grid, cfg.view_frontier_spacing)
+        pts = pts[~sg.near_any(pts, poses[visited], cfg.view_spent_radius)]
+        if pts.shape[0] == 0:
+            return states, gains, beyond
+        fa = sg.unseen_area(self.grid, pts, cfg.view_radius, cfg.view_rays)
+        keep = fa >= cfg.view_frontier_area
+        pts, fa = pts[keep], fa[keep]
+        if pts.shape[0] == 0:
+            return states, gains, beyond
+        label, dist = sg.geodesic_labels(self.grid, pts, cfg.view_frontier_reach)
+        lab = sg.lookup(self.grid, label, poses[open_], -1)
+        far = sg.lookup(self.grid, dist, poses[open_], np.inf)
+        ok = lab >= 0
+        # per frontier point, the open state nearest to it
+        best = {}
+        for s, k, d in zip(open_[ok], lab[ok], far[ok], strict=True):
+            if k not in best or d < best[k][1]:
+                best[k] = (s, d)
+        if not best:
+            return states, gains, beyond
+        fs = np.array([v[0] for v in best.values()])
+        fd = np.array([v[1] for v in best.values()])
+        fg = fa[np.array(list(best.keys()))]
+        return np.concatenate([states, fs]), np.concatenate([gains, fg]), np.concatenate([beyond, fd])
+
+    def fractions(self, areas: np.ndarray) -> np.ndarray:
+        """Unseen fraction of each view, floored at ``view_floor`` (a state never promises
+        nothing: the paper's information gain remains as a tie-break)."""
+        return np.clip(areas / self.full, self.cfg.view_floor, 1.0)

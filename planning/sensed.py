@@ -1,0 +1,255 @@
+"""A coarse "sensed" grid: which parts of the plane the LiDAR has already swept.
+
+Pure functions over a small value type. The agent shell owns the grid and feeds it every scan
+(points relative to the robot, already turned into the belief frame); planning asks, for each
+state of the map, how much free space a view from its pose would still reveal (the unseen area
+of :func:`unseen_area`). That number is what makes the information gain of visiting a state
+depend on what the robot has already sensed (``efe.sensed_info_gain``) and which states still
+promise information (the preferred states of the inductive term in exploration).
+
+Cells are ``UNKNOWN`` (0), ``FREE`` (1) or ``OCCUPIED`` (2). Rays of a scan mark the cells they
+cross free and the cell of their return occupied (an occupied cell stays occupied). The grid
+grows (by whole chunks) when a scan or a query leaves it.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+UNKNOWN, FREE, OCCUPIED = 0, 1, 2
+
+
+class SensedGrid(NamedTuple):
+    cells: np.ndarray  # (H, W) int8: UNKNOWN / FREE / OCCUPIED; row = y, column = x
+    origin: np.ndarray  # world (x, y) of the corner of cell (0, 0)
+    resolution: float  # cell size (m)
+
+
+def empty(center, resolution: float = 0.2, half_size: float = 8.0) -> SensedGrid:
+    """An all-unknown square grid of side ``2 * half_size`` around ``center``."""
+    if resolution <= 0 or half_size <= 0:
+        raise ValueError("resolution and half_size must be positive")
+    n = int(np.ceil(2 * half_size / resolution))
+    origin = np.asarray(center, dtype=float)[:2] - half_size
+    return SensedGrid(np.zeros((n, n), dtype=np.int8), origin, float(resolution))
+
+
+def to_cells(grid: SensedGrid, xy) -> np.ndarray:
+    """(row, col) integer cells of world points ``xy`` (..., 2)."""
+    xy = np.asarray(xy, dtype=float)
+    c = np.floor((xy[..., 0] - grid.origin[0]) / grid.resolution).astype(np.int64)
+    r = np.floor((xy[..., 1] - grid.origin[1]) / grid.resolution).astype(np.int64)
+    return np.stack([r, c], axis=-1)
+
+
+def ensure(grid: SensedGrid, xy, margin: float = 2.0, chunk: float = 4.0) -> SensedGrid:
+    """The same grid, padded with unknown cells (in chunks) so that every point of ``xy`` lies
+    at least ``margin`` inside it."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    res = grid.resolution
+    H, W = grid.cells.shape
+    lo = xy.min(axis=0) - margin
+    hi = xy.max(axis=0) + margin
+    top = grid.origin + np.array([W, H]) * res
+    k = max(1, int(round(chunk / res)))
+    pad_lo = np.where(lo < grid.origin, np.ceil((grid.origin - lo) / res / k) * k, 0).astype(int)
+    pad_hi = np.where(hi > top, np.ceil((hi - top) / res / k) * k, 0).astype(int)
+    if not (pad_lo.any() or pad_hi.any()):
+        return grid
+    cells = np.pad(grid.cells, ((pad_lo[1], pad_hi[1]), (pad_lo[0], pad_hi[0])), constant_values=UNKNOWN)
+    return SensedGrid(cells, grid.origin - pad_lo * res, res)
+
+
+def mark_scan(grid: SensedGrid, robot_xy, points_xy) -> SensedGrid:
+    """Add one scan: ``points_xy`` (n, 2) are the returns in the grid's (belief) frame, taken
+    from ``robot_xy``. Cells along each ray become free, the return's cell occupied."""
+    robot_xy = np.asarray(robot_xy, dtype=float)[:2]
+    pts = np.asarray(points_xy, dtype=float).reshape(-1, 2)
+    grid = ensure(grid, np.vstack([robot_xy[None, :], pts]))
+    cells = grid.cells.copy()
+    res = grid.resolution
+    if pts.shape[0]:
+        rel = pts - robot_xy
+        length = np.hypot(rel[:, 0], rel[:, 1])
+        step = res / 2
+        t = np.arange(0.0, max(float(length.max()), step), step)
+        # samples strictly before the return (half a cell short), per ray
+        ok = t[None, :] < (length[:, None] - res / 2)
+        unit = rel / np.maximum(length, 1e-9)[:, None]
+        samples = robot_xy + unit[:, None, :] * t[None, :, None]
+        rc = to_cells(grid, samples[ok])
+        cells[rc[:, 0], rc[:, 1]] = np.maximum(cells[rc[:, 0], rc[:, 1]], FREE)
+        hit = to_cells(grid, pts)
+        cells[hit[:, 0], hit[:, 1]] = OCCUPIED
+    here = to_cells(grid, robot_xy)
+    if cells[here[0], here[1]] == UNKNOWN:
+        cells[here[0], here[1]] = FREE
+    return SensedGrid(cells, grid.origin, res)
+
+
+def ray_offsets(radius: float, rays: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Sample offsets (rays, samples, 2) of a fan of ``rays`` rays up to ``radius`` and the area
+    (m2) each sample stands for (the annular wedge ``r dr dtheta`` around it)."""
+    a = 2 * np.pi * np.arange(rays) / rays
+    r = np.arange(step, radius + 1e-9, step)
+    off = r[None, :, None] * np.stack([np.cos(a), np.sin(a)], axis=1)[:, None, :]
+    return off, r * step * (2 * np.pi / rays)
+
+
+def opaque(grid: SensedGrid) -> np.ndarray:
+    """Cells that stop an imagined ray: occupied cells grown by one cell (3 x 3), so a ray cannot
+    slip diagonally between the cells of a wall the scans drew as a staircase."""
+    occ = grid.cells == OCCUPIED
+    out = occ.copy()
+    out[1:, :] |= occ[:-1, :]
+    out[:-1, :] |= occ[1:, :]
+    grown = out.copy()
+    grown[:, 1:] |= out[:, :-1]
+    grown[:, :-1] |= out[:, 1:]
+    return grown
+
+
+def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3) -> np.ndarray:
+    """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
+    would sweep, treating unknown cells as transparent and occupied cells (grown by one cell,
+    :func:`opaque`) as opaque; cells outside the grid are unknown. Samples within ``skip`` of the
+    viewpoint (the robot's own footprint) neither count nor block."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    if xy.shape[0] == 0:
+        return np.zeros(0)
+    off, w = ray_offsets(radius, rays, grid.resolution)
+    pts = xy[:, None, None, :] + off[None]  # (n, rays, samples, 2)
+    rc = to_cells(grid, pts)
+    H, W = grid.cells.shape
+    inside = (rc[..., 0] >= 0) & (rc[..., 0] < H) & (rc[..., 1] >= 0) & (rc[..., 1] < W)
+    unknown = np.ones(rc.shape[:-1], dtype=bool)
+    wall = np.zeros(rc.shape[:-1], dtype=bool)
+    r, c = rc[..., 0][inside], rc[..., 1][inside]
+    unknown[inside] = grid.cells[r, c] == UNKNOWN
+    wall[inside] = opaque(grid)[r, c]
+    near = (np.arange(off.shape[1]) + 1) * grid.resolution <= skip
+    unknown[:, :, near] = False
+    wall[:, :, near] = False
+    # a sample is visible while no opaque sample lies before it (or on it) on its ray
+    blocked = np.cumsum(wall, axis=2) > 0
+    seen = unknown & ~blocked
+    return (seen * w[None, None, :]).sum(axis=(1, 2))
+
+
+def view_area(radius: float = 6.0, rays: int = 48, resolution: float = 0.2, skip: float = 0.3) -> float:
+    """Area a view of :func:`unseen_area` stands for in an unknown, unobstructed plane (its
+    largest value), used to turn unseen areas into fractions."""
+    off, w = ray_offsets(radius, rays, resolution)
+    near = (np.arange(off.shape[1]) + 1) * resolution <= skip
+    return float(rays * w[~near].sum())
+
+
+def frontier_points(grid: SensedGrid, spacing: float = 1.0) -> np.ndarray:
+    """World points (m, 2) of the frontier, thinned to one per ``spacing`` square: free cells
+    with an unknown 4-neighbour (the edge of what the scans have swept)."""
+    cells = grid.cells
+    unk = np.pad(cells == UNKNOWN, 1, constant_values=True)
+    near_unknown = unk[:-2, 1:-1] | unk[2:, 1:-1] | unk[1:-1, :-2] | unk[1:-1, 2:]
+    r, c = np.nonzero((cells == FREE) & near_unknown)
+    if r.size == 0:
+        return np.zeros((0, 2))
+    k = max(1, int(round(spacing / grid.resolution)))
+    _, first = np.unique(np.stack([r // k, c // k], axis=1), axis=0, return_index=True)
+    r, c = r[first], c[first]
+    return grid.origin + (np.stack([c, r], axis=1) + 0.5) * grid.resolution
+
+
+def near_any(points, centres, radius: float) -> np.ndarray:
+    """Per point (m, 2): whether some centre (k, 2) lies within ``radius``."""
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+    if centres.shape[0] == 0 or points.shape[0] == 0:
+        return np.zeros(points.shape[0], dtype=bool)
+    d2 = ((points[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
+    return (d2 <= radius**2).any(axis=1)
+
+
+def best_target(gain, steps, step_length: float = 1.0, detour: float = 1.0, keep: int = -1,
+                keep_ratio: float = 1.0) -> int:
+    """Index of the target with the most information per metre, ``gain / (steps * step_length
+    + detour)`` (the oracle's rule); unreachable targets (infinite or negative steps) are never
+    chosen. The target ``keep`` (the one pursued so far) stays chosen while its score is at least
+    ``keep_ratio`` times the best, so the choice does not flip between near-equal targets.
+    Returns -1 when no target is reachable or none has positive gain."""
+    gain = np.asarray(gain, dtype=float)
+    steps = np.asarray(steps, dtype=float)
+    ok = np.isfinite(steps) & (steps >= 0) & (gain > 0)
+    if not ok.any():
+        return -1
+    score = np.where(ok, gain / (np.where(ok, steps, 0.0) * step_length + detour), -np.inf)
+    best = int(np.argmax(score))
+    if 0 <= keep < score.size and ok[keep] and score[keep] >= keep_ratio * score[best]:
+        return keep
+    return best
+
+
+def line_of_sight(grid: SensedGrid, a, b, grown: bool = False) -> np.ndarray:
+    """(m, k) bool: the straight segment from each point of ``a`` (m, 2) to each point of ``b``
+    (k, 2) crosses no occupied cell (with ``grown``, no :func:`opaque` cell); unknown cells are
+    transparent. The end cells themselves are not tested."""
+    a = np.atleast_2d(np.asarray(a, dtype=float))
+    b = np.atleast_2d(np.asarray(b, dtype=float))
+    if a.shape[0] == 0 or b.shape[0] == 0:
+        return np.zeros((a.shape[0], b.shape[0]), dtype=bool)
+    length = float(np.hypot(*(a[:, None, :] - b[None, :, :]).transpose(2, 0, 1)).max())
+    n = max(2, int(np.ceil(length / (grid.resolution / 2))))
+    t = np.linspace(0.0, 1.0, n + 1)[1:-1]
+    pts = a[:, None, None, :] + t[None, None, :, None] * (b[None, :, None, :] - a[:, None, None, :])
+    rc = to_cells(grid, pts)
+    H, W = grid.cells.shape
+    inside = (rc[..., 0] >= 0) & (rc[..., 0] < H) & (rc[..., 1] >= 0) & (rc[..., 1] < W)
+    wall = np.zeros(rc.shape[:-1], dtype=bool)
+    block = opaque(grid) if grown else grid.cells == OCCUPIED
+    wall[inside] = block[rc[..., 0][inside], rc[..., 1][inside]]
+    return ~wall.any(axis=2)
+
+
+def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.ndarray, np.ndarray]:
+    """Breadth-first growth from ``sources_xy`` (m, 2) over sensed free cells that are not
+    :func:`opaque`, up to ``max_dist``: per cell, the index of the source reached first (-1:
+    none) and the path length (m, 4-connected steps; inf: not reached). Ties go to the lower
+    source index."""
+    cells = grid.cells
+    H, W = cells.shape
+    label = np.full((H, W), -1, dtype=np.int64)
+    dist = np.full((H, W), np.inf)
+    src = to_cells(grid, np.atleast_2d(np.asarray(sources_xy, dtype=float)).reshape(-1, 2))
+    ok = (src[:, 0] >= 0) & (src[:, 0] < H) & (src[:, 1] >= 0) & (src[:, 1] < W)
+    passable = (cells == FREE) & ~opaque(grid)
+    for k in np.flatnonzero(ok)[::-1]:  # lower index written last: wins ties
+        label[src[k, 0], src[k, 1]] = k
+        dist[src[k, 0], src[k, 1]] = 0.0
+    front = label >= 0
+    big = np.iinfo(np.int64).max
+    for step in range(1, int(max_dist / grid.resolution) + 1):
+        lab = np.where(front, label, big)
+        cand = np.full((H, W), big)
+        cand[1:, :] = np.minimum(cand[1:, :], lab[:-1, :])
+        cand[:-1, :] = np.minimum(cand[:-1, :], lab[1:, :])
+        cand[:, 1:] = np.minimum(cand[:, 1:], lab[:, :-1])
+        cand[:, :-1] = np.minimum(cand[:, :-1], lab[:, 1:])
+        new = (cand < big) & (label < 0) & passable
+        if not new.any():
+            break
+        label[new] = cand[new]
+        dist[new] = step * grid.resolution
+        front = new
+    return label, dist
+
+
+def lookup(grid: SensedGrid, values: np.ndarray, xy, fill):
+    """``values`` (a per-cell array of the grid's shape) at world points ``xy`` (n, 2); ``fill``
+    outside the grid."""
+    rc = to_cells(grid, np.atleast_2d(np.asarray(xy, dtype=float)))
+    H, W = grid.cells.shape
+    inside = (rc[:, 0] >= 0) & (rc[:, 0] < H) & (rc[:, 1] >= 0) & (rc[:, 1] < W)
+    out = np.full(rc.shape[0], fill, dtype=values.dtype)
+    out[inside] = values[rc[inside, 0], rc[inside, 1]]
+    return out
