@@ -253,3 +253,20 @@ def lookup(grid: SensedGrid, values: np.ndarray, xy, fill):
     out = np.full(rc.shape[0], fill, dtype=values.dtype)
     out[inside] = values[rc[inside, 0], rc[inside, 1]]
     return out
+
+
+def crossed_segments(points, a, b, tol: float = 0.1, margin: float = 0.15) -> np.ndarray:
+    """Per segment ``a[i] -> b[i]`` ((m, 2) each): whether one of ``points`` (k, 2), e.g. the
+    returns of the latest scan, lies within ``tol`` of it, between ``margin`` and ``1 - margin``
+    of its length (so the end poses themselves are not tested)."""
+    a = np.asarray(a, dtype=float).reshape(-1, 2)
+    b = np.asarray(b, dtype=float).reshape(-1, 2)
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if a.shape[0] == 0 or p.shape[0] == 0:
+        return np.zeros(a.shape[0], dtype=bool)
+    d = b - a
+    L2 = np.maximum((d**2).sum(axis=1), 1e-12)
+    t = ((p[None, :, :] - a[:, None, :]) * d[:, None, :]).sum(axis=2) / L2[:, None]  # (m, k)
+    foot = a[:, None, :] + t[:, :, None] * d[:, None, :]
+    near = ((p[None, :, :] - foot) ** 2).sum(axis=2) <= tol**2
+    return (near & (t >= margin) & (t <= 1.0 - margin)).any(axis=1)

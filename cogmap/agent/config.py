@@ -44,6 +44,7 @@ class AgentConfig:
     view_spent_radius: float = 1.5  # a frontier point this close to a visited state is spent
     view_frontier_reach: float = 6.0  # m: a frontier point counts for an unvisited state that sees it this close
     view_keep_ratio: float = 0.7  # keep pursuing a target while its score is this close to the best
+    view_doubt_range: float = 4.0  # m: believed transitions this close are checked against the latest scan
     view_floor: float = 0.05  # smallest weight of a state's information gain
     explore_inductive_weight: float = 1.0  # inductive term toward states that still promise information
     learning: LearningRates = field(default_factory=LearningRates)

@@ -16,9 +16,14 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
     from ``state`` (plus ``beyond``, the way from that state to the view that promises it);
     empty when none is reachable within the inductive depth."""
     cfg, B, n = agent.cfg, agent.model.B[0], agent.num_states
+    src, dst = ind.edges_sparse(B.succ, B.prob, cfg.inductive_threshold, n)
+    doubt = agent.views.doubtful(agent.poses, src, dst)
+    if doubt.size:  # a believed transition crosses a newly sensed obstacle: its source has information
+        states = np.concatenate([states, doubt])
+        gains = np.concatenate([gains, np.full(doubt.size, cfg.view_min_area)])
+        beyond = np.concatenate([beyond, np.zeros(doubt.size)])
     if states.size == 0:
         return states
-    src, dst = ind.edges_sparse(B.succ, B.prob, cfg.inductive_threshold, n)
     steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth)[states].astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
     last = getattr(agent.views, "target", -1)

@@ -20,6 +20,7 @@ class ViewMap:
         self.cfg = cfg
         self.grid: sg.SensedGrid | None = None
         self.area = np.zeros(0)  # unseen area (m2) per state; NaN: not computed yet
+        self.robot, self.returns = None, np.zeros((0, 2))  # the latest scan, belief frame
         self.target = -1  # state pursued by the inductive term (kept while nearly the best)
         self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
 
@@ -40,6 +41,7 @@ class ViewMap:
         if self.grid is None:
             self.grid = sg.empty(robot, self.cfg.view_resolution)
         self.grid = sg.mark_scan(self.grid, robot, pts)
+        self.robot, self.returns = robot, pts
 
     def areas(self, poses: np.ndarray, visited: np.ndarray) -> np.ndarray | None:
         """Unseen view area (m2) of every state (``poses`` (n, 2)); None before any scan. A state
@@ -55,6 +57,26 @@ class ViewMap:
         if stale.size:
             self.area[stale] = sg.unseen_area(self.grid, poses[stale], self.cfg.view_radius, self.cfg.view_rays)
         return self.area[:n]
+
+    def doubtful(self, poses: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+        """States from which a transition believed possible (``src -> dst``), both ends within
+        ``view_doubt_range`` of the robot, is crossed by a return of the latest scan (something
+        now stands on it), and that still have another believed-possible transition (not a state
+        the obstacle now covers): visiting them would update B_s there (parameter information
+        gain). Only nearby transitions are checked, where odometry drift has not moved the scan
+        against the map."""
+        if self.robot is None or src.size == 0:
+            return np.zeros(0, dtype=np.int64)
+        d = np.hypot(*(poses - self.robot).T)
+        near = (d[src] <= self.cfg.view_doubt_range) & (d[dst] <= self.cfg.view_doubt_range)
+        if not near.any():
+            return np.zeros(0, dtype=np.int64)
+        bad = np.zeros(src.size, dtype=bool)
+        bad[near] = sg.crossed_segments(self.returns, poses[src[near]], poses[dst[near]])
+        if not bad.any():
+            return np.zeros(0, dtype=np.int64)
+        sources = np.unique(src[bad])
+        return sources[np.isin(sources, np.unique(src[~bad]))]
 
     def candidates(self, poses: np.ndarray, visited: np.ndarray,
                    areas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
