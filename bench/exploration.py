@@ -76,7 +76,11 @@ def main(argv=None) -> None:
     ap.add_argument("--figure", default=None, help="also draw the per-decision EFE terms of a house run to this PNG")
     args = ap.parse_args(argv)
     if args.figure:
-        from docs.efe_terms import draw  # noqa: PLC0415 - optional, needs matplotlib
+        import sys
+        from pathlib import Path
+
+        sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "docs"))
+        from efe_terms import draw  # the figure script of docs/exploration.md
 
         draw(args.figure)
         return

@@ -6,6 +6,8 @@ import numpy as np
 
 from cogmap.planning import efe, sensed
 from cogmap.planning import inductive as ind
+from cogmap.planning.arrays import from_model, prepare
+from cogmap.planning.context import LocalStep
 from cogmap.planning.decide import decide as mcts_decide
 from cogmap.planning.mcts import MCTSConfig
 
@@ -58,9 +60,23 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
                 objective = efe.sensed_exploration(inductive_weight=cfg.explore_inductive_weight)
                 view = views.fractions(areas)
             # else: nothing reachable is left unseen; the paper's terms alone (the model still learns)
-    d = mcts_decide(model, [agent.q[:n]], obstacles, objective, goal_states=goal_states, view=view, config=mcfg,
-                    rng=agent.rng)
-    out = {"actions": d.actions, "Q": d.Q, "visits": d.visits}
+    arrays = from_model(model, goal_states=goal_states, view=view)
+    d = mcts_decide(arrays, [agent.q[:n]], obstacles, objective, config=mcfg, rng=agent.rng)
+    out = {"actions": d.actions, "Q": d.Q, "visits": d.visits, "objective": objective, "arrays": arrays,
+           "obstacles": obstacles}
     if view is not None:
         out["preferred"] = goal_states
     return int(d.action), out
+
+
+def term_breakdown(agent, efe_summary: dict, action: int) -> dict[str, float]:
+    """Weighted contribution of every EFE term to the first step of ``action`` (same sign as G:
+    negative is attractive), as the last decision's objective saw it. Call it right after the
+    decision (the model keeps learning)."""
+    arrays, objective = efe_summary["arrays"], efe_summary["objective"]
+    prep = prepare(arrays, local=True)
+    q = np.asarray(agent.q[: arrays.num_states[0]], dtype=float)
+    idx = np.flatnonzero(q > 1e-9 * q.max())
+    coll = np.asarray(efe_summary["obstacles"], dtype=float)[[action]]
+    ctx = LocalStep(prep, idx, q[idx] / q[idx].sum(), np.array([action]), 0, coll)
+    return {k: float(v[0]) for k, v in objective.breakdown(ctx).items()}
