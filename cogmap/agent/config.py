@@ -43,6 +43,7 @@ class AgentConfig:
     view_frontier_area: float = 4.0  # m2 unseen from a frontier point for it to count
     view_spent_radius: float = 1.5  # a frontier point this close to a visited state is spent
     view_frontier_reach: float = 6.0  # m: a frontier point counts for an unvisited state that sees it this close
+    view_detour: float = 1.0  # m added to the path in unseen area / (path + detour), as for the oracle
     view_keep_ratio: float = 0.7  # keep pursuing a target while its score is this close to the best
     view_doubt_range: float = 4.0  # m: believed transitions this close are checked against the latest scan
     view_floor: float = 0.05  # smallest weight of a state's information gain

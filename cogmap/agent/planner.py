@@ -30,8 +30,8 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
     steps[steps >= ind.UNREACHABLE] = np.inf
     last = getattr(agent.views, "target", -1)
     keep = int(np.flatnonzero(states == last)[0]) if last >= 0 and (states == last).any() else -1
-    i = sensed.best_target(gains, steps + beyond / cfg.influence_radius, cfg.influence_radius, keep=keep,
-                           keep_ratio=cfg.view_keep_ratio)
+    i = sensed.best_target(gains, steps + beyond / cfg.influence_radius, cfg.influence_radius, cfg.view_detour,
+                           keep=keep, keep_ratio=cfg.view_keep_ratio)
     agent.views.target = int(states[i]) if i >= 0 else -1
     return states[i:i + 1] if i >= 0 else states[:0]
 
