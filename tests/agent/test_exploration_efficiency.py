@@ -40,3 +40,18 @@ def test_house_exploration_reaches_90_percent_efficiently():
     results = [_ce_at_90("house", seed, 200) for seed in (0, 2)]
     assert all(ce is not None and cov >= 0.9 for ce, cov in results), results
     assert np.mean([ce for ce, _ in results]) >= THRESHOLD, results
+
+
+def test_exploration_page_python_blocks_run():
+    import re
+    from pathlib import Path
+
+    page = Path(__file__).resolve().parents[2] / "docs" / "exploration.md"
+    code = re.findall(r"```python\n(.*?)```", page.read_text(), flags=re.S)
+    assert code
+    namespace: dict = {}
+    for i, block in enumerate(code):
+        exec(compile(block, f"exploration.md[block {i}]", "exec"), namespace)
+    assert namespace["objective"].names == ("sensed_info_gain", "inductive", "collision")
+    near, far = namespace["sg"].unseen_area(namespace["grid"], [[0.0, 0.0], [0.0, -3.0]])
+    assert near < far
