@@ -89,6 +89,39 @@ def mark_scan(grid: SensedGrid, robot_xy, points_xy) -> SensedGrid:
     return SensedGrid(cells, grid.origin, res)
 
 
+def changed_bounds(before: SensedGrid, after: SensedGrid):
+    """World box ``(xmin, ymin, xmax, ymax)`` of the cells whose value differs between two grids
+    over the same cells (``after = mark_scan(ensure(before, ...), ...)``), or None."""
+    if before.cells.shape != after.cells.shape or not np.allclose(before.origin, after.origin):
+        raise ValueError("changed_bounds() compares two grids over the same cells")
+    r, c = np.nonzero(before.cells != after.cells)
+    if r.size == 0:
+        return None
+    res = after.resolution
+    lo = after.origin + np.array([c.min(), r.min()]) * res
+    hi = after.origin + np.array([c.max() + 1, r.max() + 1]) * res
+    return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+
+
+def box_within(xy, box, radius: float) -> np.ndarray:
+    """Per point (n, 2): whether the box ``(xmin, ymin, xmax, ymax)`` comes within ``radius``."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    if box is None:
+        return np.zeros(xy.shape[0], dtype=bool)
+    dx = np.maximum(np.maximum(box[0] - xy[:, 0], xy[:, 0] - box[2]), 0.0)
+    dy = np.maximum(np.maximum(box[1] - xy[:, 1], xy[:, 1] - box[3]), 0.0)
+    return dx**2 + dy**2 <= radius**2
+
+
+def merge_boxes(a, b):
+    """Smallest box holding both (either may be None)."""
+    if a is None:
+        return b
+    if b is None:
+        return a
+    return (min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3]))
+
+
 def ray_offsets(radius: float, rays: int, step: float) -> tuple[np.ndarray, np.ndarray]:
     """Sample offsets (rays, samples, 2) of a fan of ``rays`` rays up to ``radius`` and the area
     (m2) each sample stands for (the annular wedge ``r dr dtheta`` around it)."""
@@ -163,12 +196,14 @@ def frontier_points(grid: SensedGrid, spacing: float = 1.0) -> np.ndarray:
 
 def near_any(points, centres, radius: float) -> np.ndarray:
     """Per point (m, 2): whether some centre (k, 2) lies within ``radius``."""
+    from scipy.spatial import cKDTree
+
     points = np.atleast_2d(np.asarray(points, dtype=float))
     centres = np.asarray(centres, dtype=float).reshape(-1, 2)
     if centres.shape[0] == 0 or points.shape[0] == 0:
         return np.zeros(points.shape[0], dtype=bool)
-    d2 = ((points[:, None, :] - centres[None, :, :]) ** 2).sum(axis=2)
-    return (d2 <= radius**2).any(axis=1)
+    d, _ = cKDTree(centres).query(points, k=1, distance_upper_bound=radius * (1 + 1e-12))
+    return np.isfinite(d)
 
 
 def best_target(gain, steps, step_length: float = 1.0, detour: float = 1.0, keep: int = -1,
@@ -216,32 +251,47 @@ def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.n
     :func:`opaque`, up to ``max_dist``: per cell, the index of the source reached first (-1:
     none) and the path length (m, 4-connected steps; inf: not reached). Ties go to the lower
     source index."""
-    cells = grid.cells
-    H, W = cells.shape
-    label = np.full((H, W), -1, dtype=np.int64)
-    dist = np.full((H, W), np.inf)
+    H, W = grid.cells.shape
+    full_label = np.full((H, W), -1, dtype=np.int64)
+    full_dist = np.full((H, W), np.inf)
     src = to_cells(grid, np.atleast_2d(np.asarray(sources_xy, dtype=float)).reshape(-1, 2))
     ok = (src[:, 0] >= 0) & (src[:, 0] < H) & (src[:, 1] >= 0) & (src[:, 1] < W)
-    passable = (cells == FREE) & ~opaque(grid)
-    for k in np.flatnonzero(ok)[::-1]:  # lower index written last: wins ties
-        label[src[k, 0], src[k, 1]] = k
-        dist[src[k, 0], src[k, 1]] = 0.0
-    front = label >= 0
-    big = np.iinfo(np.int64).max
-    for step in range(1, int(max_dist / grid.resolution) + 1):
-        lab = np.where(front, label, big)
-        cand = np.full((H, W), big)
-        cand[1:, :] = np.minimum(cand[1:, :], lab[:-1, :])
-        cand[:-1, :] = np.minimum(cand[:-1, :], lab[1:, :])
-        cand[:, 1:] = np.minimum(cand[:, 1:], lab[:, :-1])
-        cand[:, :-1] = np.minimum(cand[:, :-1], lab[:, 1:])
-        new = (cand < big) & (label < 0) & passable
-        if not new.any():
-            break
-        label[new] = cand[new]
-        dist[new] = step * grid.resolution
-        front = new
-    return label, dist
+    if not ok.any():
+        return full_label, full_dist
+    # nothing farther than max_dist from a source is reached: work in that window only
+    m = int(max_dist / grid.resolution) + 2
+    r0, c0 = max(int(src[ok, 0].min()) - m, 0), max(int(src[ok, 1].min()) - m, 0)
+    r1, c1 = min(int(src[ok, 0].max()) + m + 1, H), min(int(src[ok, 1].max()) + m + 1, W)
+    passable = ((grid.cells == FREE) & ~opaque(grid))[r0:r1, c0:c1]
+    src = src[ok] - np.array([r0, c0])
+    src_idx = np.flatnonzero(ok)
+    Hw, Ww = passable.shape
+    passable[src[:, 0], src[:, 1]] = True  # a source is walkable even at the fringe of a wall
+    # 4-connected graph of the window's passable cells; multi-source Dijkstra (unit steps)
+    flat = np.arange(Hw * Ww).reshape(Hw, Ww)
+    right = passable[:, :-1] & passable[:, 1:]
+    down = passable[:-1, :] & passable[1:, :]
+    i = np.concatenate([flat[:, :-1][right], flat[:-1, :][down]])
+    j = np.concatenate([flat[:, 1:][right], flat[1:, :][down]])
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    graph = coo_matrix((np.ones(i.size), (i, j)), shape=(Hw * Ww, Hw * Ww)).tocsr()
+    start = flat[src[:, 0], src[:, 1]]
+    # the first source of each cell wins ties, as "lower index" (sources are visited in order)
+    order = np.argsort(src_idx, kind="stable")
+    steps, _, which = dijkstra(graph, directed=False, indices=start[order], min_only=True,
+                               return_predecessors=True, limit=max_dist / grid.resolution + 1e-9)
+    reached = np.isfinite(steps) & (which >= 0)
+    label = np.full(Hw * Ww, -1, dtype=np.int64)
+    pos = np.full(Hw * Ww, -1, dtype=np.int64)
+    pos[start[order]] = src_idx[order]
+    label[reached] = pos[which[reached]]
+    dist = np.where(reached, steps * grid.resolution, np.inf)
+    label, dist = label.reshape(Hw, Ww), dist.reshape(Hw, Ww)
+    full_label[r0:r1, c0:c1] = label
+    full_dist[r0:r1, c0:c1] = dist
+    return full_label, full_dist
 
 
 def lookup(grid: SensedGrid, values: np.ndarray, xy, fill):

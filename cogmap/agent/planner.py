@@ -15,8 +15,9 @@ from cogmap.planning.mcts import MCTSConfig
 def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np.ndarray) -> np.ndarray:
     """The preferred state of the inductive term while exploring: among the states that still
     promise information, the one with the most unseen area per metre of believed-possible path
-    from ``state`` (plus ``beyond``, the way from that state to the view that promises it);
-    empty when none is reachable within the inductive depth."""
+    from ``state`` (plus ``beyond``, the way from that state to the view that promises it).
+    Sources of believed transitions that the latest scan shows blocked count as candidates too
+    (worth ``view_min_area``). Empty when none is reachable within the inductive depth."""
     cfg, B, n = agent.cfg, agent.model.B[0], agent.num_states
     src, dst = ind.edges_sparse(B.succ, B.prob, cfg.inductive_threshold, n)
     doubt = agent.views.doubtful(agent.poses, src, dst)

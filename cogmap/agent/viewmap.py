@@ -21,6 +21,8 @@ class ViewMap:
         self.grid: sg.SensedGrid | None = None
         self.area = np.zeros(0)  # unseen area (m2) per state; NaN: not computed yet
         self.robot, self.returns = None, np.zeros((0, 2))  # the latest scan, belief frame
+        self.frontier_cache: dict = {}  # frontier point -> unseen area, while nothing near it changes
+        self._dirty_states = self._dirty_frontier = None  # box of cells changed since the last query
         self.target = -1  # state pursued by the inductive term (kept while nearly the best)
         self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
 
@@ -40,8 +42,12 @@ class ViewMap:
         pts = robot + rel[:, :1] * ex + rel[:, 1:] * ey
         if self.grid is None:
             self.grid = sg.empty(robot, self.cfg.view_resolution)
-        self.grid = sg.mark_scan(self.grid, robot, pts)
+        before = sg.ensure(self.grid, np.vstack([robot[None, :], pts]))
+        self.grid = sg.mark_scan(before, robot, pts)
         self.robot, self.returns = robot, pts
+        box = sg.changed_bounds(before, self.grid)  # views within reach of it must be recomputed
+        self._dirty_states = sg.merge_boxes(self._dirty_states, box)
+        self._dirty_frontier = sg.merge_boxes(self._dirty_frontier, box)
 
     def areas(self, poses: np.ndarray, visited: np.ndarray) -> np.ndarray | None:
         """Unseen view area (m2) of every state (``poses`` (n, 2)); None before any scan. A state
@@ -53,7 +59,12 @@ class ViewMap:
         if self.area.size < n:
             self.area = np.concatenate([self.area, np.full(n - self.area.size, np.nan)])
         self.area[:n][np.asarray(visited[:n], dtype=bool)] = 0.0
-        stale = np.flatnonzero(~(self.area[:n] < self.cfg.view_min_area))  # NaN or still informative
+        # recompute new states, and informative ones whose view reaches a cell that changed
+        new = np.isnan(self.area[:n])
+        live = (self.area[:n] >= self.cfg.view_min_area) & sg.box_within(poses, self._dirty_states,
+                                                                           self.cfg.view_radius)
+        self._dirty_states = None
+        stale = np.flatnonzero(new | live)
         if stale.size:
             self.area[stale] = sg.unseen_area(self.grid, poses[stale], self.cfg.view_radius, self.cfg.view_rays)
         return self.area[:n]
@@ -97,7 +108,7 @@ class ViewMap:
         pts = pts[~sg.near_any(pts, poses[visited], cfg.view_spent_radius)]
         if pts.shape[0] == 0:
             return states, gains, beyond
-        fa = sg.unseen_area(self.grid, pts, cfg.view_radius, cfg.view_rays)
+        fa = self._frontier_areas(pts)
         keep = fa >= cfg.view_frontier_area
         pts, fa = pts[keep], fa[keep]
         if pts.shape[0] == 0:
@@ -117,6 +128,23 @@ class ViewMap:
         fd = np.array([v[1] for v in best.values()])
         fg = fa[np.array(list(best.keys()))]
         return np.concatenate([states, fs]), np.concatenate([gains, fg]), np.concatenate([beyond, fd])
+
+    def _frontier_areas(self, pts: np.ndarray) -> np.ndarray:
+        """Unseen areas of frontier points, reusing those whose view no changed cell reaches."""
+        cfg = self.cfg
+        dirty = sg.box_within(np.asarray(list(self.frontier_cache) or np.zeros((0, 2))).reshape(-1, 2),
+                              self._dirty_frontier, cfg.view_radius)
+        for key, d in zip(list(self.frontier_cache), dirty, strict=True):
+            if d:
+                del self.frontier_cache[key]
+        self._dirty_frontier = None
+        keys = [(float(x), float(y)) for x, y in pts]
+        self.frontier_cache = {k: self.frontier_cache[k] for k in keys if k in self.frontier_cache}
+        todo = [i for i, k in enumerate(keys) if k not in self.frontier_cache]
+        if todo:
+            fresh = sg.unseen_area(self.grid, pts[todo], cfg.view_radius, cfg.view_rays)
+            self.frontier_cache.update({keys[i]: float(a) for i, a in zip(todo, fresh, strict=True)})
+        return np.array([self.frontier_cache[k] for k in keys])
 
     def fractions(self, areas: np.ndarray) -> np.ndarray:
         """Unseen fraction of each view, floored at ``view_floor`` (a state never promises
