@@ -3,9 +3,10 @@
 CE@90 = area covered / distance travelled, both read when LiDAR coverage first reaches 90 %
 (``bench/exploration.py`` computes it the same way over every layout and 5 seeds).
 Measured on seeds 0 and 2 (``python bench/exploration.py --envs house``): before the sensed-grid
-terms 1.86 and 2.07 m2/m (mean 1.97), with them 2.17 and 2.47 (mean 2.32); the oracle tour
-reaches 3.89 and 3.78. The threshold 2.15 lies between the two means, so the test fails if the
-agent falls back to visiting the map node by node.
+terms 1.86 and 2.07 m2/m (mean 1.97), with them 2.63 and 3.12 (mean 2.88); the oracle tour
+reaches 3.89 and 3.78. The threshold 2.3 lies between the two means (0.3 above the old one,
+0.6 below the new one), so the test fails if the agent falls back to visiting the map node by
+node.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import numpy as np
 from cogmap.agent.aimapp import AIMAPPAgent
 from cogmap.explore import coverage_tracker, default_config, make_sim, run_agent
 
-THRESHOLD = 2.15
+THRESHOLD = 2.3
 
 
 def _ce_at_90(env: str, seed: int, steps: int) -> tuple[float | None, float]:
