@@ -56,3 +56,51 @@ def test_exploration_page_python_blocks_run():
     assert namespace["objective"].names == ("sensed_info_gain", "inductive", "collision")
     near, far = namespace["sg"].unseen_area(namespace["grid"], [[0.0, 0.0], [0.0, -3.0]])
     assert near < far
+
+
+class _RigidAgent:
+    """Stands in for the agent's pose helper: belief = rotation by ``theta`` then a shift."""
+
+    def __init__(self, theta, shift):
+        c, s = np.cos(theta), np.sin(theta)
+        self.R, self.t = np.array([[c, -s], [s, c]]), np.asarray(shift, dtype=float)
+
+    def believed_pose(self, odometry):
+        return self.R @ np.asarray(odometry, dtype=float)[:2] + self.t
+
+
+def test_scan_goes_through_the_agents_pose_mapping_even_when_it_rotates():
+    from cogmap.agent.aimapp import Sensed
+    from cogmap.agent.config import AgentConfig
+    from cogmap.agent.viewmap import ViewMap
+    from cogmap.planning import sensed as sg
+
+    agent = _RigidAgent(np.pi / 2, (5.0, -1.0))
+    views = ViewMap(AgentConfig())
+    odom = np.array([1.0, 2.0, 0.3])
+    scan = np.array([[2.0, 0.0], [0.0, -1.5]])  # returns relative to the robot, odometry frame
+    views.observe(agent, Sensed(None, None, odom, None, scan))
+    expected = np.array([agent.believed_pose(odom[:2] + p) for p in scan])
+    np.testing.assert_allclose(views.returns, expected, atol=1e-12)
+    rc = sg.to_cells(views.grid, expected)
+    assert (views.grid.cells[rc[:, 0], rc[:, 1]] == sg.OCCUPIED).all()
+    np.testing.assert_allclose(views.robot, agent.believed_pose(odom))
+
+
+def test_a_believed_transition_crossed_by_a_return_makes_its_source_preferred():
+    from cogmap.agent.config import AgentConfig
+    from cogmap.agent.viewmap import ViewMap
+
+    views = ViewMap(AgentConfig())
+    poses = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [1.0, 1.0]])
+    # believed-possible transitions both ways along 0-1-2 and 1-3
+    src = np.array([0, 1, 1, 2, 1, 3])
+    dst = np.array([1, 0, 2, 1, 3, 1])
+    views.robot = np.array([0.0, 0.0])
+    views.returns = np.zeros((0, 2))
+    assert views.doubtful(poses, src, dst).size == 0
+    views.returns = np.array([[1.5, 0.02]])  # something now stands between states 1 and 2
+    # state 1 can still go elsewhere (to 0 and 3): it is preferred; state 2's only way is blocked
+    assert views.doubtful(poses, src, dst).tolist() == [1]
+    views.robot = np.array([20.0, 0.0])  # too far from the robot to be checked (drift)
+    assert views.doubtful(poses, src, dst).size == 0
