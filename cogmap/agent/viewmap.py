@@ -23,6 +23,7 @@ class ViewMap:
         self.robot, self.returns = None, np.zeros((0, 2))  # the latest scan, belief frame
         self.frontier_cache: dict = {}  # frontier point -> unseen area, while nothing near it changes
         self._dirty_states = self._dirty_frontier = None  # box of cells changed since the last query
+        self.doubt: set[int] = set()  # states beside a moved obstacle, preferred until visited
         self.target = -1  # state pursued by the inductive term (kept while nearly the best)
         self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
 
@@ -69,25 +70,28 @@ class ViewMap:
             self.area[stale] = sg.unseen_area(self.grid, poses[stale], self.cfg.view_radius, self.cfg.view_rays)
         return self.area[:n]
 
-    def doubtful(self, poses: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.ndarray:
+    def doubtful(self, poses: np.ndarray, src: np.ndarray, dst: np.ndarray, state: int) -> np.ndarray:
         """States from which a transition believed possible (``src -> dst``), both ends within
         ``view_doubt_range`` of the robot, is crossed by a return of the latest scan (something
-        now stands on it), and that still have another believed-possible transition (not a state
-        the obstacle now covers): visiting them would update B_s there (parameter information
-        gain). Only nearby transitions are checked, where odometry drift has not moved the scan
-        against the map."""
-        if self.robot is None or src.size == 0:
-            return np.zeros(0, dtype=np.int64)
-        d = np.hypot(*(poses - self.robot).T)
-        near = (d[src] <= self.cfg.view_doubt_range) & (d[dst] <= self.cfg.view_doubt_range)
-        if not near.any():
-            return np.zeros(0, dtype=np.int64)
-        bad = np.zeros(src.size, dtype=bool)
-        bad[near] = sg.crossed_segments(self.returns, poses[src[near]], poses[dst[near]])
-        if not bad.any():
-            return np.zeros(0, dtype=np.int64)
-        sources = np.unique(src[bad])
-        return sources[np.isin(sources, np.unique(src[~bad]))]
+        now stands on it), that the robot sees (no return between it and the state: not a state
+        behind or under the obstacle) and that still have another believed-possible transition:
+        visiting them would update B_s there (parameter information gain). They stay preferred
+        until the robot stands on them (``state``). Only nearby transitions are checked, where
+        odometry drift has not moved the scan against the map."""
+        self.doubt.discard(int(state))
+        if self.robot is not None and src.size:
+            d = np.hypot(*(poses - self.robot).T)
+            near = (d[src] <= self.cfg.view_doubt_range) & (d[dst] <= self.cfg.view_doubt_range)
+            if near.any():
+                bad = np.zeros(src.size, dtype=bool)
+                bad[near] = sg.crossed_segments(self.returns, poses[src[near]], poses[dst[near]])
+                if bad.any():
+                    sources = np.unique(src[bad])
+                    sources = sources[np.isin(sources, np.unique(src[~bad])) & (sources != state)]
+                    seen = ~sg.crossed_segments(self.returns, np.repeat(self.robot[None, :], sources.size, 0),
+                                                poses[sources], tol=self.cfg.robot_radius, margin=0.0)
+                    self.doubt.update(int(s) for s in sources[seen])
+        return np.array(sorted(self.doubt), dtype=np.int64)
 
     def candidates(self, poses: np.ndarray, visited: np.ndarray,
                    areas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

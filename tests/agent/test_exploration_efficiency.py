@@ -98,9 +98,20 @@ def test_a_believed_transition_crossed_by_a_return_makes_its_source_preferred():
     dst = np.array([1, 0, 2, 1, 3, 1])
     views.robot = np.array([0.0, 0.0])
     views.returns = np.zeros((0, 2))
-    assert views.doubtful(poses, src, dst).size == 0
+    assert views.doubtful(poses, src, dst, 0).size == 0
     views.returns = np.array([[1.5, 0.02]])  # something now stands between states 1 and 2
     # state 1 can still go elsewhere (to 0 and 3): it is preferred; state 2's only way is blocked
-    assert views.doubtful(poses, src, dst).tolist() == [1]
+    assert views.doubtful(poses, src, dst, 0).tolist() == [1]
+    views.returns = np.zeros((0, 2))  # out of sight now: still preferred until the robot stands on it
+    assert views.doubtful(poses, src, dst, 0).tolist() == [1]
+    assert views.doubtful(poses, src, dst, 1).size == 0
+    # a state behind the obstacle (the robot would see it through the obstacle) is not preferred
+    views.doubt.clear()
+    poses4 = np.vstack([poses, [[1.0, 2.0]]])
+    src4, dst4 = np.append(src, [3, 4]), np.append(dst, [4, 3])  # 3 also reaches a new state 4
+    views.robot = np.array([1.0, -1.0])
+    views.returns = np.array([[1.0, 0.5]])  # on 1-3, between the robot and state 3
+    assert views.doubtful(poses4, src4, dst4, 0).tolist() == [1]  # not 3, hidden behind it
+    views.doubt.clear()
     views.robot = np.array([20.0, 0.0])  # too far from the robot to be checked (drift)
-    assert views.doubtful(poses, src, dst).size == 0
+    assert views.doubtful(poses, src, dst, 0).size == 0
