@@ -43,6 +43,7 @@ class PlanningArrays:
     inductive_depth: int = 10
     collision_pref: float = -10.0  # log-preference of a collision (no collision: 0)
     control_factor: int = 0  # factor whose controls the obstacle signal refers to
+    view: np.ndarray | None = None  # per state of pose_factor: unseen fraction of its view, in [0, 1]
 
     @property
     def num_factors(self) -> int:
@@ -84,6 +85,7 @@ def from_model(
     goal_states=None,
     goal_factor: int | None = None,
     collision_pref: float | None = None,
+    view=None,
 ) -> PlanningArrays:
     """Adapter: the arrays of a compiled ``cogmap.genmodel.Model`` (views, nothing copied).
 
@@ -129,6 +131,7 @@ def from_model(
         inductive_depth=10 if ind_spec is None else int(ind_spec.depth),
         collision_pref=-10.0 if cp is None else float(cp),
         control_factor=pf,
+        view=None if view is None else np.asarray(view, dtype=float),
     )
 
 

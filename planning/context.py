@@ -7,7 +7,8 @@ terms it uses:
 ``qs_prev``, ``qo`` (per modality, (K, o_m)), ``ambiguity`` (per modality, (K,)),
 ``a_novelty`` / ``b_novelty`` (per modality / factor, (K,) or None), ``C``, ``C_states``,
 ``poses``, ``pose_factor``, ``pose_sigma``, ``target_pose``, ``collision`` ((K,) or None),
-``collision_pref``, ``closer`` ((K,) or None).
+``collision_pref``, ``closer`` ((K,) or None), ``view`` ((K,) or None: expected unseen
+fraction of the predicted state's view).
 
 :class:`DenseStep` works on full (multi-factor) beliefs, like pymdp. :class:`LocalStep` works on
 one factor with sparse transitions from a sparse prior: every array is restricted to ``U``, the
@@ -159,6 +160,14 @@ class DenseStep(_Common):
         return None if a.poses is None else a.poses[: a.num_states[a.pose_factor]]
 
     @cached_property
+    def view(self):
+        v = self._a.view
+        if v is None:
+            return None
+        f = self._a.pose_factor
+        return self.qs[f] @ v[: self._a.num_states[f]]
+
+    @cached_property
     def closer(self):
         dist = self.prep.dist
         if dist is None:
@@ -266,6 +275,11 @@ class LocalStep(_Common):
     def poses(self):
         a = self._a
         return None if a.poses is None else a.poses[self.U]
+
+    @cached_property
+    def view(self):
+        v = self._a.view
+        return None if v is None else self.qs[0] @ v[self.U]
 
     @cached_property
     def closer(self):

@@ -10,7 +10,7 @@ from . import efe
 from .arrays import PlanningArrays, from_model, prepare
 from .mcts import Decision, MCTSConfig, mcts
 
-MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full}
+MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full, "sensed": efe.sensed_exploration}
 
 
 def make_objective(mode, inductive_weight: float | None = None) -> efe.Objective:
@@ -19,7 +19,7 @@ def make_objective(mode, inductive_weight: float | None = None) -> efe.Objective
         return mode
     if mode not in MODES:
         raise ValueError(f"unknown planning mode '{mode}' (known: {sorted(MODES)} or an Objective)")
-    if mode in ("goal", "full") and inductive_weight is not None:
+    if mode in ("goal", "full", "sensed") and inductive_weight is not None:
         return MODES[mode](inductive_weight=inductive_weight)
     return MODES[mode]()
 
@@ -32,6 +32,7 @@ def decide(
     *,
     target_pose=None,
     goal_states=None,
+    view=None,
     config: MCTSConfig | None = None,
     rng: np.random.Generator | int | None = None,
 ) -> Decision:
@@ -40,20 +41,23 @@ def decide(
     ``model`` is a compiled ``cogmap.genmodel.Model`` or :class:`PlanningArrays`; ``qs`` the
     current belief (a list per factor, or one array for a single factor); ``obstacles`` one
     bool per control of the moving factor (True: obstacle in that direction); ``mode``
-    "explore", "goal", "full" or a custom objective. Depth and simulations default to the
+    "explore", "goal", "full", "sensed" or a custom objective; ``view`` the unseen fraction of
+    each state's view (read by ``efe.sensed_info_gain``), ``goal_states`` the preferred states
+    of the inductive term. Depth and simulations default to the
     model's inductive depth and 30.
     """
     if isinstance(model, PlanningArrays):
         arrays = model
-        if target_pose is not None or goal_states is not None:
+        if target_pose is not None or goal_states is not None or view is not None:
             arrays = replace(
                 arrays,
                 target_pose=arrays.target_pose if target_pose is None else np.asarray(target_pose, float),
                 goal_states=arrays.goal_states if goal_states is None else np.asarray(goal_states),
+                view=arrays.view if view is None else np.asarray(view, float),
             )
         ind_w = None
     else:
-        arrays = from_model(model, target_pose=target_pose, goal_states=goal_states)
+        arrays = from_model(model, target_pose=target_pose, goal_states=goal_states, view=view)
         ind_w = None if model.inductive is None else float(model.inductive.weight)
     if isinstance(qs, np.ndarray) and qs.ndim == 1:
         qs = [qs]
@@ -61,7 +65,8 @@ def decide(
     cfg = config or MCTSConfig(depth=arrays.inductive_depth)
     prep = prepare(
         arrays,
-        need_novelty=obj.uses(efe.param_info_gain) or obj.uses(efe.a_novelty) or obj.uses(efe.b_novelty),
+        need_novelty=any(obj.uses(t) for t in (efe.param_info_gain, efe.a_novelty, efe.b_novelty,
+                                                efe.sensed_info_gain)),
         need_goal=obj.uses(efe.inductive),
     )
     return mcts(prep, qs, obj, obstacles, cfg, rng)

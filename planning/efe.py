@@ -82,6 +82,17 @@ def param_info_gain(ctx) -> np.ndarray:
     return a_novelty(ctx) + b_novelty(ctx)
 
 
+def sensed_info_gain(ctx) -> np.ndarray:
+    """Information gain on states and parameters, weighted by what the LiDAR has not yet sensed:
+    ``(state_info_gain + param_info_gain) * E_Q(s)[w(s)]`` with ``w(s)`` in [0, 1] the fraction
+    of the view from state ``s`` that is still unseen (``ctx.view``). The observation a state
+    would yield carries information about the map only where its view reaches unseen space, so a
+    state whose surroundings the LiDAR has already swept promises (almost) nothing. Without a
+    view weight (no scans) this is the plain epistemic value of Eq. 6."""
+    gain = state_info_gain(ctx) + param_info_gain(ctx)
+    return gain if ctx.view is None else gain * ctx.view
+
+
 def observation_preference(ctx) -> np.ndarray:
     """Expected log-preference over outcomes, ``sum_m Q(o_m) . C_m``."""
     out = np.zeros(ctx.num_candidates)
@@ -136,11 +147,12 @@ ALL_TERMS: dict[str, Term] = {
     "position_preference": position_preference,
     "state_preference": state_preference,
     "inductive": inductive,
+    "sensed_info_gain": sensed_info_gain,
 }
 
 
 #: terms whose value is information: gained once, so not counted again on a revisit (MCTS)
-EPISTEMIC = (state_info_gain, param_info_gain, a_novelty, b_novelty)
+EPISTEMIC = (state_info_gain, param_info_gain, a_novelty, b_novelty, sensed_info_gain)
 
 
 # -- combinator ------------------------------------------------------------------------------
@@ -203,6 +215,22 @@ def exploration(collision_weight: float = 1.0, epistemic_weight: float = 1.0) ->
         [
             (state_info_gain, epistemic_weight),
             (param_info_gain, epistemic_weight),
+            (collision, collision_weight),
+        ]
+    )
+
+
+def sensed_exploration(
+    collision_weight: float = 1.0, epistemic_weight: float = 1.0, inductive_weight: float = 1.0
+) -> Objective:
+    """Exploration that knows what the LiDAR has sensed: the information gain weighted by the
+    unseen part of each state's view (:func:`sensed_info_gain`), the inductive term (Eq. 9)
+    with the states that still promise information as its preferred states (so MCTS is pulled
+    toward unexplored parts beyond its depth), and collision."""
+    return objective(
+        [
+            (sensed_info_gain, epistemic_weight),
+            (inductive, inductive_weight),
             (collision, collision_weight),
         ]
     )

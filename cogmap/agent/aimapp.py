@@ -44,6 +44,7 @@ from .correction import Anchor, relocalise, to_frame_panorama, track
 from .encoder import Encoder, SSIMEncoder
 from .mapping import direction, expansion_free_energies, reverse_heading
 from .sensing import blocked
+from .viewmap import ViewMap
 
 
 @dataclass
@@ -120,6 +121,7 @@ class AIMAPPAgent:
         self.lost_events = 0
         self.last_obs: int | None = None
         self.relocalisations = 0
+        self.views = ViewMap(self.cfg)  # what the LiDAR has sensed (exploration planning only)
 
     # -- public ------------------------------------------------------------------------------
     @property
@@ -204,6 +206,8 @@ class AIMAPPAgent:
             pose = self.believed_pose(sensed.odometry)
             local = self._to_belief(sensed)
         expanded = self._update(q, conf, obs, local, pose, score)
+        if not self.lost:  # what the LiDAR swept, mapped through the (corrected) belief frame
+            self.views.observe(self, sensed)
         decision = self._decide(local, pose, conf, expanded)
         decision.missing = missing
         self.last, self._outcome = decision, None

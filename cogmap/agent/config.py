@@ -46,6 +46,21 @@ class AgentConfig:
     min_correction: float = 0.1
     min_correction_yaw: float = 0.035
     lost_slack: float = 1.0  # nats of conflict tolerated per step by the lost test (CUSUM)
+    # Exploration that knows what the LiDAR has sensed (docs/exploration.md); 0 weight: paper terms only
+    view_weighting: bool = True  # weight the information gain by the unseen part of each state's view
+    view_resolution: float = 0.2  # cell size of the agent's sensed grid (m)
+    view_radius: float = 6.0  # range of the imagined view from a state (m)
+    view_rays: int = 48
+    view_min_area: float = 1.0  # m2 unseen: a state below this no longer promises information
+    view_frontier_spacing: float = 1.0  # frontier points one per this square (m) when no state promises anything
+    view_frontier_area: float = 4.0  # m2 unseen from a frontier point for it to count
+    view_spent_radius: float = 1.5  # a frontier point this close to a visited state is spent
+    view_frontier_reach: float = 6.0  # m: a frontier point counts for an unvisited state that sees it this close
+    view_detour: float = 1.0  # m added to the path in unseen area / (path + detour), as for the oracle
+    view_keep_ratio: float = 0.7  # keep pursuing a target while its score is this close to the best
+    view_doubt_range: float = 4.0  # m: believed transitions this close are checked against the latest scan
+    view_floor: float = 0.05  # smallest weight of a state's information gain
+    explore_inductive_weight: float = 1.0  # inductive term toward states that still promise information
     learning: LearningRates = field(default_factory=LearningRates)
     initial_capacity: int = 64
 

@@ -1,0 +1,156 @@
+"""What the agent's LiDAR has already sensed, in the belief frame, and what each state's view
+would still reveal (the stateful side of ``cogmap.planning.sensed``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from cogmap.planning import sensed as sg
+
+
+class ViewMap:
+    """Owns the sensed grid and a per-state cache of unseen view areas.
+
+    Unseen areas only shrink as scans accumulate (cells go from unknown to free or occupied),
+    so a state whose area fell below ``min_area`` is never queried again; each decision queries
+    the states that still promise something and the new ones.
+    """
+
+    def __init__(self, cfg):
+        self.cfg = cfg
+        self.grid: sg.SensedGrid | None = None
+        self.area = np.zeros(0)  # unseen area (m2) per state; NaN: not computed yet
+        self.robot, self.returns = None, np.zeros((0, 2))  # the latest scan, belief frame
+        self.frontier_cache: dict = {}  # frontier point -> unseen area, while nothing near it changes
+        self._dirty_states = self._dirty_frontier = None  # box of cells changed since the last query
+        self.doubt: set[int] = set()  # states beside a moved obstacle, preferred until visited
+        self.target = -1  # state pursued by the inductive term (kept while nearly the best)
+        self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
+
+    def observe(self, agent, sensed) -> None:
+        """Add the scan of ``sensed`` (points relative to the robot, odometry frame) to the grid,
+        through the agent's own odometry -> belief mapping."""
+        scan = sensed.scan
+        if scan is None or sensed.odometry is None:
+            return
+        odom = np.asarray(sensed.odometry, dtype=float)
+        robot = agent.believed_pose(odom)
+        # the agent's odometry -> belief mapping, read at two unit offsets (exact for any affine,
+        # e.g. rigid, correction), applied to the returns
+        ex = agent.believed_pose(odom + np.r_[1.0, 0.0, np.zeros(odom.size - 2)]) - robot
+        ey = agent.believed_pose(odom + np.r_[0.0, 1.0, np.zeros(odom.size - 2)]) - robot
+        rel = np.asarray(scan, dtype=float).reshape(-1, 2)
+        pts = robot + rel[:, :1] * ex + rel[:, 1:] * ey
+        if self.grid is None:
+            self.grid = sg.empty(robot, self.cfg.view_resolution)
+        before = sg.ensure(self.grid, np.vstack([robot[None, :], pts]))
+        self.grid = sg.mark_scan(before, robot, pts)
+        self.robot, self.returns = robot, pts
+        box = sg.changed_bounds(before, self.grid)  # views within reach of it must be recomputed
+        self._dirty_states = sg.merge_boxes(self._dirty_states, box)
+        self._dirty_frontier = sg.merge_boxes(self._dirty_frontier, box)
+
+    def areas(self, poses: np.ndarray, visited: np.ndarray) -> np.ndarray | None:
+        """Unseen view area (m2) of every state (``poses`` (n, 2)); None before any scan. A state
+        the robot has stood on (``visited``) has been seen from: whatever its imagined view still
+        misses is not visible from there (as for the oracle's viewpoints)."""
+        if self.grid is None:
+            return None
+        n = len(poses)
+        if self.area.size < n:
+            self.area = np.concatenate([self.area, np.full(n - self.area.size, np.nan)])
+        self.area[:n][np.asarray(visited[:n], dtype=bool)] = 0.0
+        # recompute new states, and informative ones whose view reaches a cell that changed
+        new = np.isnan(self.area[:n])
+        live = (self.area[:n] >= self.cfg.view_min_area) & sg.box_within(poses, self._dirty_states,
+                                                                           self.cfg.view_radius)
+        self._dirty_states = None
+        stale = np.flatnonzero(new | live)
+        if stale.size:
+            self.area[stale] = sg.unseen_area(self.grid, poses[stale], self.cfg.view_radius, self.cfg.view_rays)
+        return self.area[:n]
+
+    def doubtful(self, poses: np.ndarray, src: np.ndarray, dst: np.ndarray, state: int) -> np.ndarray:
+        """States from which a transition believed possible (``src -> dst``), both ends within
+        ``view_doubt_range`` of the robot, is crossed by a return of the latest scan (something
+        now stands on it), that the robot sees (no return between it and the state: not a state
+        behind or under the obstacle) and that still have another believed-possible transition:
+        visiting them would update B_s there (parameter information gain). They stay preferred
+        until the robot stands on them (``state``). Only nearby transitions are checked, where
+        odometry drift has not moved the scan against the map."""
+        self.doubt.discard(int(state))
+        if self.robot is not None and src.size:
+            d = np.hypot(*(poses - self.robot).T)
+            near = (d[src] <= self.cfg.view_doubt_range) & (d[dst] <= self.cfg.view_doubt_range)
+            if near.any():
+                bad = np.zeros(src.size, dtype=bool)
+                bad[near] = sg.crossed_segments(self.returns, poses[src[near]], poses[dst[near]])
+                if bad.any():
+                    sources = np.unique(src[bad])
+                    sources = sources[np.isin(sources, np.unique(src[~bad])) & (sources != state)]
+                    seen = ~sg.crossed_segments(self.returns, np.repeat(self.robot[None, :], sources.size, 0),
+                                                poses[sources], tol=self.cfg.robot_radius, margin=0.0)
+                    self.doubt.update(int(s) for s in sources[seen])
+        return np.array(sorted(self.doubt), dtype=np.int64)
+
+    def candidates(self, poses: np.ndarray, visited: np.ndarray,
+                   areas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """States that still promise information, how much (m2), and how far (m) beyond the
+        state the view that promises it lies: the states whose own view would reveal at least
+        ``view_min_area`` (0 m beyond), and the unvisited states nearest (along sensed free
+        space) to a frontier point whose view would reveal ``view_frontier_area``, that no
+        visited state stands near (what is left unseen there is not visible from close by), within
+        ``view_frontier_reach`` (the map grows from that state toward the frontier)."""
+        cfg = self.cfg
+        visited = np.asarray(visited[: len(poses)], dtype=bool)
+        states = np.flatnonzero(areas >= cfg.view_min_area)
+        gains, beyond = areas[states], np.zeros(states.size)
+        open_ = np.flatnonzero(~visited)
+        if self.grid is None or open_.size == 0:
+            return states, gains, beyond
+        pts = sg.frontier_points(self.grid, cfg.view_frontier_spacing)
+        pts = pts[~sg.near_any(pts, poses[visited], cfg.view_spent_radius)]
+        if pts.shape[0] == 0:
+            return states, gains, beyond
+        fa = self._frontier_areas(pts)
+        keep = fa >= cfg.view_frontier_area
+        pts, fa = pts[keep], fa[keep]
+        if pts.shape[0] == 0:
+            return states, gains, beyond
+        label, dist = sg.geodesic_labels(self.grid, pts, cfg.view_frontier_reach)
+        lab = sg.lookup(self.grid, label, poses[open_], -1)
+        far = sg.lookup(self.grid, dist, poses[open_], np.inf)
+        ok = lab >= 0
+        # per frontier point, the open state nearest to it
+        best = {}
+        for s, k, d in zip(open_[ok], lab[ok], far[ok], strict=True):
+            if k not in best or d < best[k][1]:
+                best[k] = (s, d)
+        if not best:
+            return states, gains, beyond
+        fs = np.array([v[0] for v in best.values()])
+        fd = np.array([v[1] for v in best.values()])
+        fg = fa[np.array(list(best.keys()))]
+        return np.concatenate([states, fs]), np.concatenate([gains, fg]), np.concatenate([beyond, fd])
+
+    def _frontier_areas(self, pts: np.ndarray) -> np.ndarray:
+        """Unseen areas of frontier points, reusing those whose view no changed cell reaches."""
+        cfg = self.cfg
+        dirty = sg.box_within(np.asarray(list(self.frontier_cache) or np.zeros((0, 2))).reshape(-1, 2),
+                              self._dirty_frontier, cfg.view_radius)
+        for key, d in zip(list(self.frontier_cache), dirty, strict=True):
+            if d:
+                del self.frontier_cache[key]
+        self._dirty_frontier = None
+        keys = [(float(x), float(y)) for x, y in pts]
+        self.frontier_cache = {k: self.frontier_cache[k] for k in keys if k in self.frontier_cache}
+        todo = [i for i, k in enumerate(keys) if k not in self.frontier_cache]
+        if todo:
+            fresh = sg.unseen_area(self.grid, pts[todo], cfg.view_radius, cfg.view_rays)
+            self.frontier_cache.update({keys[i]: float(a) for i, a in zip(todo, fresh, strict=True)})
+        return np.array([self.frontier_cache[k] for k in keys])
+
+    def fractions(self, areas: np.ndarray) -> np.ndarray:
+        """Unseen fraction of each view, floored at ``view_floor`` (a state never promises
+        nothing: the paper's information gain remains as a tie-break)."""
+        return np.clip(areas / self.full, self.cfg.view_floor, 1.0)

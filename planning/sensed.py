@@ -1,0 +1,322 @@
+"""A coarse "sensed" grid: which parts of the plane the LiDAR has already swept.
+
+Pure functions over a small value type. The agent shell owns the grid and feeds it every scan
+(points relative to the robot, already turned into the belief frame); planning asks, for each
+state of the map, how much free space a view from its pose would still reveal (the unseen area
+of :func:`unseen_area`). That number is what makes the information gain of visiting a state
+depend on what the robot has already sensed (``efe.sensed_info_gain``) and which states still
+promise information (the preferred states of the inductive term in exploration).
+
+Cells are ``UNKNOWN`` (0), ``FREE`` (1) or ``OCCUPIED`` (2). Rays of a scan mark the cells they
+cross free and the cell of their return occupied (an occupied cell stays occupied). The grid
+grows (by whole chunks) when a scan or a query leaves it.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+UNKNOWN, FREE, OCCUPIED = 0, 1, 2
+
+
+class SensedGrid(NamedTuple):
+    cells: np.ndarray  # (H, W) int8: UNKNOWN / FREE / OCCUPIED; row = y, column = x
+    origin: np.ndarray  # world (x, y) of the corner of cell (0, 0)
+    resolution: float  # cell size (m)
+
+
+def empty(center, resolution: float = 0.2, half_size: float = 8.0) -> SensedGrid:
+    """An all-unknown square grid of side ``2 * half_size`` around ``center``."""
+    if resolution <= 0 or half_size <= 0:
+        raise ValueError("resolution and half_size must be positive")
+    n = int(np.ceil(2 * half_size / resolution))
+    origin = np.asarray(center, dtype=float)[:2] - half_size
+    return SensedGrid(np.zeros((n, n), dtype=np.int8), origin, float(resolution))
+
+
+def to_cells(grid: SensedGrid, xy) -> np.ndarray:
+    """(row, col) integer cells of world points ``xy`` (..., 2)."""
+    xy = np.asarray(xy, dtype=float)
+    c = np.floor((xy[..., 0] - grid.origin[0]) / grid.resolution).astype(np.int64)
+    r = np.floor((xy[..., 1] - grid.origin[1]) / grid.resolution).astype(np.int64)
+    return np.stack([r, c], axis=-1)
+
+
+def ensure(grid: SensedGrid, xy, margin: float = 2.0, chunk: float = 4.0) -> SensedGrid:
+    """The same grid, padded with unknown cells (in chunks) so that every point of ``xy`` lies
+    at least ``margin`` inside it."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    res = grid.resolution
+    H, W = grid.cells.shape
+    lo = xy.min(axis=0) - margin
+    hi = xy.max(axis=0) + margin
+    top = grid.origin + np.array([W, H]) * res
+    k = max(1, int(round(chunk / res)))
+    pad_lo = np.where(lo < grid.origin, np.ceil((grid.origin - lo) / res / k) * k, 0).astype(int)
+    pad_hi = np.where(hi > top, np.ceil((hi - top) / res / k) * k, 0).astype(int)
+    if not (pad_lo.any() or pad_hi.any()):
+        return grid
+    cells = np.pad(grid.cells, ((pad_lo[1], pad_hi[1]), (pad_lo[0], pad_hi[0])), constant_values=UNKNOWN)
+    return SensedGrid(cells, grid.origin - pad_lo * res, res)
+
+
+def mark_scan(grid: SensedGrid, robot_xy, points_xy) -> SensedGrid:
+    """Add one scan: ``points_xy`` (n, 2) are the returns in the grid's (belief) frame, taken
+    from ``robot_xy``. Cells along each ray become free, the return's cell occupied."""
+    robot_xy = np.asarray(robot_xy, dtype=float)[:2]
+    pts = np.asarray(points_xy, dtype=float).reshape(-1, 2)
+    grid = ensure(grid, np.vstack([robot_xy[None, :], pts]))
+    cells = grid.cells.copy()
+    res = grid.resolution
+    if pts.shape[0]:
+        rel = pts - robot_xy
+        length = np.hypot(rel[:, 0], rel[:, 1])
+        step = res / 2
+        t = np.arange(0.0, max(float(length.max()), step), step)
+        # samples strictly before the return (half a cell short), per ray
+        ok = t[None, :] < (length[:, None] - res / 2)
+        unit = rel / np.maximum(length, 1e-9)[:, None]
+        samples = robot_xy + unit[:, None, :] * t[None, :, None]
+        rc = to_cells(grid, samples[ok])
+        cells[rc[:, 0], rc[:, 1]] = np.maximum(cells[rc[:, 0], rc[:, 1]], FREE)
+        hit = to_cells(grid, pts)
+        cells[hit[:, 0], hit[:, 1]] = OCCUPIED
+    here = to_cells(grid, robot_xy)
+    if cells[here[0], here[1]] == UNKNOWN:
+        cells[here[0], here[1]] = FREE
+    return SensedGrid(cells, grid.origin, res)
+
+
+def changed_bounds(before: SensedGrid, after: SensedGrid):
+    """World box ``(xmin, ymin, xmax, ymax)`` of the cells whose value differs between two grids
+    over the same cells (``after = mark_scan(ensure(before, ...), ...)``), or None."""
+    if before.cells.shape != after.cells.shape or not np.allclose(before.origin, after.origin):
+        raise ValueError("changed_bounds() compares two grids over the same cells")
+    r, c = np.nonzero(before.cells != after.cells)
+    if r.size == 0:
+        return None
+    res = after.resolution
+    lo = after.origin + np.array([c.min(), r.min()]) * res
+    hi = after.origin + np.array([c.max() + 1, r.max() + 1]) * res
+    return (float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1]))
+
+
+def box_within(xy, box, radius: float) -> np.ndarray:
+    """Per point (n, 2): whether the box ``(xmin, ymin, xmax, ymax)`` comes within ``radius``."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    if box is None:
+        return np.zeros(xy.shape[0], dtype=bool)
+    dx = np.maximum(np.maximum(box[0] - xy[:, 0], xy[:, 0] - box[2]), 0.0)
+    dy = np.maximum(np.maximum(box[1] - xy[:, 1], xy[:, 1] - box[3]), 0.0)
+    return dx**2 + dy**2 <= radius**2
+
+
+def merge_boxes(a, b):
+    """Smallest box holding both (either may be None)."""
+    if a is None:
+        return b
+    if b is None:
+        return a
+    return (min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3]))
+
+
+def ray_offsets(radius: float, rays: int, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Sample offsets (rays, samples, 2) of a fan of ``rays`` rays up to ``radius`` and the area
+    (m2) each sample stands for (the annular wedge ``r dr dtheta`` around it)."""
+    a = 2 * np.pi * np.arange(rays) / rays
+    r = np.arange(step, radius + 1e-9, step)
+    off = r[None, :, None] * np.stack([np.cos(a), np.sin(a)], axis=1)[:, None, :]
+    return off, r * step * (2 * np.pi / rays)
+
+
+def opaque(grid: SensedGrid) -> np.ndarray:
+    """Cells that stop an imagined ray: occupied cells grown by one cell (3 x 3), so a ray cannot
+    slip diagonally between the cells of a wall the scans drew as a staircase."""
+    occ = grid.cells == OCCUPIED
+    out = occ.copy()
+    out[1:, :] |= occ[:-1, :]
+    out[:-1, :] |= occ[1:, :]
+    grown = out.copy()
+    grown[:, 1:] |= out[:, :-1]
+    grown[:, :-1] |= out[:, 1:]
+    return grown
+
+
+def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3) -> np.ndarray:
+    """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
+    would sweep, treating unknown cells as transparent and occupied cells (grown by one cell,
+    :func:`opaque`) as opaque; cells outside the grid are unknown. Samples within ``skip`` of the
+    viewpoint (the robot's own footprint) neither count nor block."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    if xy.shape[0] == 0:
+        return np.zeros(0)
+    off, w = ray_offsets(radius, rays, grid.resolution)
+    pts = xy[:, None, None, :] + off[None]  # (n, rays, samples, 2)
+    rc = to_cells(grid, pts)
+    H, W = grid.cells.shape
+    inside = (rc[..., 0] >= 0) & (rc[..., 0] < H) & (rc[..., 1] >= 0) & (rc[..., 1] < W)
+    unknown = np.ones(rc.shape[:-1], dtype=bool)
+    wall = np.zeros(rc.shape[:-1], dtype=bool)
+    r, c = rc[..., 0][inside], rc[..., 1][inside]
+    unknown[inside] = grid.cells[r, c] == UNKNOWN
+    wall[inside] = opaque(grid)[r, c]
+    near = (np.arange(off.shape[1]) + 1) * grid.resolution <= skip
+    unknown[:, :, near] = False
+    wall[:, :, near] = False
+    # a sample is visible while no opaque sample lies before it (or on it) on its ray
+    blocked = np.cumsum(wall, axis=2) > 0
+    seen = unknown & ~blocked
+    return (seen * w[None, None, :]).sum(axis=(1, 2))
+
+
+def view_area(radius: float = 6.0, rays: int = 48, resolution: float = 0.2, skip: float = 0.3) -> float:
+    """Area a view of :func:`unseen_area` stands for in an unknown, unobstructed plane (its
+    largest value), used to turn unseen areas into fractions."""
+    off, w = ray_offsets(radius, rays, resolution)
+    near = (np.arange(off.shape[1]) + 1) * resolution <= skip
+    return float(rays * w[~near].sum())
+
+
+def frontier_points(grid: SensedGrid, spacing: float = 1.0) -> np.ndarray:
+    """World points (m, 2) of the frontier, thinned to one per ``spacing`` square: free cells
+    with an unknown 4-neighbour (the edge of what the scans have swept)."""
+    cells = grid.cells
+    unk = np.pad(cells == UNKNOWN, 1, constant_values=True)
+    near_unknown = unk[:-2, 1:-1] | unk[2:, 1:-1] | unk[1:-1, :-2] | unk[1:-1, 2:]
+    r, c = np.nonzero((cells == FREE) & near_unknown)
+    if r.size == 0:
+        return np.zeros((0, 2))
+    k = max(1, int(round(spacing / grid.resolution)))
+    _, first = np.unique(np.stack([r // k, c // k], axis=1), axis=0, return_index=True)
+    r, c = r[first], c[first]
+    return grid.origin + (np.stack([c, r], axis=1) + 0.5) * grid.resolution
+
+
+def near_any(points, centres, radius: float) -> np.ndarray:
+    """Per point (m, 2): whether some centre (k, 2) lies within ``radius``."""
+    from scipy.spatial import cKDTree
+
+    points = np.atleast_2d(np.asarray(points, dtype=float))
+    centres = np.asarray(centres, dtype=float).reshape(-1, 2)
+    if centres.shape[0] == 0 or points.shape[0] == 0:
+        return np.zeros(points.shape[0], dtype=bool)
+    d, _ = cKDTree(centres).query(points, k=1, distance_upper_bound=radius * (1 + 1e-12))
+    return np.isfinite(d)
+
+
+def best_target(gain, steps, step_length: float = 1.0, detour: float = 1.0, keep: int = -1,
+                keep_ratio: float = 1.0) -> int:
+    """Index of the target with the most information per metre, ``gain / (steps * step_length
+    + detour)`` (the oracle's rule); unreachable targets (infinite or negative steps) are never
+    chosen. The target ``keep`` (the one pursued so far) stays chosen while its score is at least
+    ``keep_ratio`` times the best, so the choice does not flip between near-equal targets.
+    Returns -1 when no target is reachable or none has positive gain."""
+    gain = np.asarray(gain, dtype=float)
+    steps = np.asarray(steps, dtype=float)
+    ok = np.isfinite(steps) & (steps >= 0) & (gain > 0)
+    if not ok.any():
+        return -1
+    score = np.where(ok, gain / (np.where(ok, steps, 0.0) * step_length + detour), -np.inf)
+    best = int(np.argmax(score))
+    if 0 <= keep < score.size and ok[keep] and score[keep] >= keep_ratio * score[best]:
+        return keep
+    return best
+
+
+def line_of_sight(grid: SensedGrid, a, b, grown: bool = False) -> np.ndarray:
+    """(m, k) bool: the straight segment from each point of ``a`` (m, 2) to each point of ``b``
+    (k, 2) crosses no occupied cell (with ``grown``, no :func:`opaque` cell); unknown cells are
+    transparent. The end cells themselves are not tested."""
+    a = np.atleast_2d(np.asarray(a, dtype=float))
+    b = np.atleast_2d(np.asarray(b, dtype=float))
+    if a.shape[0] == 0 or b.shape[0] == 0:
+        return np.zeros((a.shape[0], b.shape[0]), dtype=bool)
+    length = float(np.hypot(*(a[:, None, :] - b[None, :, :]).transpose(2, 0, 1)).max())
+    n = max(2, int(np.ceil(length / (grid.resolution / 2))))
+    t = np.linspace(0.0, 1.0, n + 1)[1:-1]
+    pts = a[:, None, None, :] + t[None, None, :, None] * (b[None, :, None, :] - a[:, None, None, :])
+    rc = to_cells(grid, pts)
+    H, W = grid.cells.shape
+    inside = (rc[..., 0] >= 0) & (rc[..., 0] < H) & (rc[..., 1] >= 0) & (rc[..., 1] < W)
+    wall = np.zeros(rc.shape[:-1], dtype=bool)
+    block = opaque(grid) if grown else grid.cells == OCCUPIED
+    wall[inside] = block[rc[..., 0][inside], rc[..., 1][inside]]
+    return ~wall.any(axis=2)
+
+
+def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.ndarray, np.ndarray]:
+    """Breadth-first growth from ``sources_xy`` (m, 2) over sensed free cells that are not
+    :func:`opaque`, up to ``max_dist``: per cell, the index of the source reached first (-1:
+    none) and the path length (m, 4-connected steps; inf: not reached). Ties go to the lower
+    source index."""
+    H, W = grid.cells.shape
+    full_label = np.full((H, W), -1, dtype=np.int64)
+    full_dist = np.full((H, W), np.inf)
+    src = to_cells(grid, np.atleast_2d(np.asarray(sources_xy, dtype=float)).reshape(-1, 2))
+    ok = (src[:, 0] >= 0) & (src[:, 0] < H) & (src[:, 1] >= 0) & (src[:, 1] < W)
+    if not ok.any():
+        return full_label, full_dist
+    # nothing farther than max_dist from a source is reached: work in that window only
+    m = int(max_dist / grid.resolution) + 2
+    r0, c0 = max(int(src[ok, 0].min()) - m, 0), max(int(src[ok, 1].min()) - m, 0)
+    r1, c1 = min(int(src[ok, 0].max()) + m + 1, H), min(int(src[ok, 1].max()) + m + 1, W)
+    passable = ((grid.cells == FREE) & ~opaque(grid))[r0:r1, c0:c1]
+    src = src[ok] - np.array([r0, c0])
+    src_idx = np.flatnonzero(ok)
+    Hw, Ww = passable.shape
+    passable[src[:, 0], src[:, 1]] = True  # a source is walkable even at the fringe of a wall
+    # 4-connected graph of the window's passable cells; multi-source Dijkstra (unit steps)
+    flat = np.arange(Hw * Ww).reshape(Hw, Ww)
+    right = passable[:, :-1] & passable[:, 1:]
+    down = passable[:-1, :] & passable[1:, :]
+    i = np.concatenate([flat[:, :-1][right], flat[:-1, :][down]])
+    j = np.concatenate([flat[:, 1:][right], flat[1:, :][down]])
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    graph = coo_matrix((np.ones(i.size), (i, j)), shape=(Hw * Ww, Hw * Ww)).tocsr()
+    start = flat[src[:, 0], src[:, 1]]
+    # the first source of each cell wins ties, as "lower index" (sources are visited in order)
+    order = np.argsort(src_idx, kind="stable")
+    steps, _, which = dijkstra(graph, directed=False, indices=start[order], min_only=True,
+                               return_predecessors=True, limit=max_dist / grid.resolution + 1e-9)
+    reached = np.isfinite(steps) & (which >= 0)
+    label = np.full(Hw * Ww, -1, dtype=np.int64)
+    pos = np.full(Hw * Ww, -1, dtype=np.int64)
+    pos[start[order]] = src_idx[order]
+    label[reached] = pos[which[reached]]
+    dist = np.where(reached, steps * grid.resolution, np.inf)
+    label, dist = label.reshape(Hw, Ww), dist.reshape(Hw, Ww)
+    full_label[r0:r1, c0:c1] = label
+    full_dist[r0:r1, c0:c1] = dist
+    return full_label, full_dist
+
+
+def lookup(grid: SensedGrid, values: np.ndarray, xy, fill):
+    """``values`` (a per-cell array of the grid's shape) at world points ``xy`` (n, 2); ``fill``
+    outside the grid."""
+    rc = to_cells(grid, np.atleast_2d(np.asarray(xy, dtype=float)))
+    H, W = grid.cells.shape
+    inside = (rc[:, 0] >= 0) & (rc[:, 0] < H) & (rc[:, 1] >= 0) & (rc[:, 1] < W)
+    out = np.full(rc.shape[0], fill, dtype=values.dtype)
+    out[inside] = values[rc[inside, 0], rc[inside, 1]]
+    return out
+
+
+def crossed_segments(points, a, b, tol: float = 0.1, margin: float = 0.15) -> np.ndarray:
+    """Per segment ``a[i] -> b[i]`` ((m, 2) each): whether one of ``points`` (k, 2), e.g. the
+    returns of the latest scan, lies within ``tol`` of it, between ``margin`` and ``1 - margin``
+    of its length (so the end poses themselves are not tested)."""
+    a = np.asarray(a, dtype=float).reshape(-1, 2)
+    b = np.asarray(b, dtype=float).reshape(-1, 2)
+    p = np.asarray(points, dtype=float).reshape(-1, 2)
+    if a.shape[0] == 0 or p.shape[0] == 0:
+        return np.zeros(a.shape[0], dtype=bool)
+    d = b - a
+    L2 = np.maximum((d**2).sum(axis=1), 1e-12)
+    t = ((p[None, :, :] - a[:, None, :]) * d[:, None, :]).sum(axis=2) / L2[:, None]  # (m, k)
+    foot = a[:, None, :] + t[:, :, None] * d[:, None, :]
+    near = ((p[None, :, :] - foot) ** 2).sum(axis=2) <= tol**2
+    return (near & (t >= margin) & (t <= 1.0 - margin)).any(axis=1)
