@@ -204,12 +204,19 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
 
 class Done:
     """The agent's own end of exploration: for ``patience`` decisions the map has not grown and
-    no state has been visited for the first time (no ground truth involved). Decisions taken
+    no state has been visited for the first time, or for ``SEEN_ALL`` decisions its sensed map
+    has shown nothing reachable left to see (no ground truth involved). Decisions taken
     while a sensor stream is silent do not count: the map cannot grow without the LiDAR, nor
     can a view be tied to a new state without the camera."""
 
+    #: consecutive exploring decisions in which the agent's own sensed map shows nothing reachable
+    #: left to see (no state whose view would reveal unseen area) before it declares itself done,
+    #: as a frontier explorer does when no frontier is left
+    SEEN_ALL = 3
+
     def __init__(self, agent: AIMAPPAgent, patience: int):
         self.agent, self.patience, self.quiet, self.seen = agent, patience, 0, (0, 0)
+        self.seen_all = 0
 
     def __call__(self, decision) -> bool:
         a = self.agent
@@ -219,7 +226,16 @@ class Done:
             return False
         self.quiet = self.quiet + 1 if seen == self.seen else 0
         self.seen = seen
-        return self.patience > 0 and self.quiet >= self.patience
+        views = getattr(a, "views", None)
+        nothing_left = (getattr(decision, "mode", "") == "explore" and a.cfg.view_weighting and views is not None
+                        and views.grid is not None and getattr(views, "target", -1) < 0)
+        self.seen_all = self.seen_all + 1 if nothing_left else 0
+        return self.finished
+
+    @property
+    def finished(self) -> bool:
+        """The agent has declared its exploration over."""
+        return self.patience > 0 and (self.quiet >= self.patience or self.seen_all >= self.SEEN_ALL)
 
 
 def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: Path | str | None = None,
@@ -241,7 +257,7 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
                            config=cfg.to_dict(), noise=asdict(noise or OdometryNoise()))
         done = Done(agent, patience)
         ep = run_agent(sim, agent, steps, progress, stop=done)
-        metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.quiet >= patience > 0}
+        metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.finished}
         if out is not None:
             write_run(out, sim, agent, ep, metrics)
         return metrics

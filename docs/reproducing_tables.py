@@ -13,8 +13,8 @@ import re
 from pathlib import Path
 
 DOCS = Path(__file__).resolve().parent
-ORDER = ["exploration-reduced", "exploration-full", "success-full", "goals-full", "drift-full", "obstacle-full",
-         "scaling-full"]
+ORDER = ["exploration-reduced", "exploration-full", "success-full", "goals-full", "drift-full", "slip-full",
+         "dropout-full", "obstacle-full", "scaling-full"]
 
 
 def studies() -> list[tuple[str, Path]]:

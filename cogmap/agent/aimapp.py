@@ -122,6 +122,7 @@ class AIMAPPAgent:
         self.last_obs: int | None = None
         self.relocalisations = 0
         self.views = ViewMap(self.cfg)  # what the LiDAR has sensed (exploration planning only)
+        self.scanned: set[int] = set()  # states the agent has stood on with its LiDAR reporting
 
     # -- public ------------------------------------------------------------------------------
     @property
@@ -206,8 +207,10 @@ class AIMAPPAgent:
             pose = self.believed_pose(sensed.odometry)
             local = self._to_belief(sensed)
         expanded = self._update(q, conf, obs, local, pose, score)
-        if not self.lost:  # what the LiDAR swept, mapped through the (corrected) belief frame
+        if not self.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
             self.views.observe(self, sensed)
+            if conf.confident:
+                self.scanned.add(int(np.argmax(q)))
         decision = self._decide(local, pose, conf, expanded)
         decision.missing = missing
         self.last, self._outcome = decision, None
@@ -375,6 +378,13 @@ class AIMAPPAgent:
 
     def _reverse(self, action: int) -> int | None:
         return reverse_heading(action, self.cfg.num_headings) if action != self.cfg.stay else None
+
+    def scanned_from(self) -> np.ndarray:
+        """Mask of states the agent has stood on with its LiDAR reporting: what their view can
+        reveal has been seen (a state passed while the LiDAR was silent still promises it)."""
+        mask = np.zeros(self.num_states, dtype=bool)
+        mask[list(self.scanned)] = True
+        return mask
 
     def visited(self) -> np.ndarray:
         """Mask of states whose observation model has been taught (the agent has been there)."""

@@ -26,6 +26,7 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
         gains = np.concatenate([gains, np.full(doubt.size, cfg.view_min_area)])
         beyond = np.concatenate([beyond, np.zeros(doubt.size)])
     if states.size == 0:
+        agent.views.target = -1
         return states
     steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth)[states].astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
@@ -54,9 +55,10 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     else:
         objective, goal_states = efe.exploration(), None
         views = getattr(agent, "views", None)
-        areas = views.areas(agent.poses, agent.visited()) if views is not None and cfg.view_weighting else None
+        seen_from = agent.scanned_from() if hasattr(agent, "scanned_from") else agent.visited()
+        areas = views.areas(agent.poses, seen_from) if views is not None and cfg.view_weighting else None
         if areas is not None:  # what the LiDAR has sensed weights the information gain; informative states pull
-            goal_states = _target(agent, state, *views.candidates(agent.poses, agent.visited(), areas))
+            goal_states = _target(agent, state, *views.candidates(agent.poses, seen_from, areas))
             if goal_states.size:
                 objective = efe.sensed_exploration(inductive_weight=cfg.explore_inductive_weight)
                 view = views.fractions(areas)

@@ -108,7 +108,7 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
         agent = AIMAPPAgent(aimapp_config(method, env), seed=seed)
         done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
         ep = run_agent(sim, agent, steps, progress=False, stop=done)
-        return sim, ep, agent, bool(done.patience > 0 and done.quiet >= done.patience)
+        return sim, ep, agent, done.finished
     pol = make_policy(method, sim, cfg.influence_radius, seed, config)
     ep = run_policy(sim, pol, steps)
     return sim, ep, pol, bool(ep.rows and ep.rows[-1]["mode"] == "done")

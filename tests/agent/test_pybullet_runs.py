@@ -29,7 +29,7 @@ def test_mini_warehouse_coverage_in_four_of_five_seeds():
 
 def test_command_line_main_job_writes_a_complete_run(tmp_path, capsys):
     out = tmp_path / "run"
-    assert main(["explore", "--steps", "12", "--seed", "3", "--out", str(out), "--quiet"]) == 0
+    assert main(["explore", "--steps", "12", "--patience", "0", "--seed", "3", "--out", str(out), "--quiet"]) == 0
     names = {p.name for p in out.iterdir()}
     assert {"run.json", "model.npz", "model.json", "map.graphml", "trajectory.csv", "metrics.json", "map.png",
             "coverage.png", "observations"} <= names
@@ -214,3 +214,9 @@ def test_aliased_racks_do_not_make_the_agent_lost_with_exact_odometry():
         assert max(errors) < 0.2
     finally:
         sim.close()
+
+
+def test_house_exploration_ends_once_its_own_sensed_map_has_nothing_left_to_see():
+    result = explore("house", steps=300, seed=1, progress=False, patience=20)
+    assert result["ended_by_agent"] and result["steps"] < 150  # it used to walk all 300 decisions
+    assert result["coverage"] >= 0.95
