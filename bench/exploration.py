@@ -37,7 +37,7 @@ def run(env: str, method: str, seed: int, steps: int) -> dict:
     from cogmap.explore import coverage_tracker
     from cogmap.study.runs import explore_episode
 
-    sim, ep, _ = explore_episode(env, method, seed, steps, stop_coverage=0.99)
+    sim, ep, _, _ = explore_episode(env, method, seed, steps)  # the studies' run end (own end or budget)
     try:
         tracker = coverage_tracker(sim)
         free = tracker.total * sim.grid.resolution**2

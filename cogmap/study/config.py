@@ -15,7 +15,8 @@ METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 AIMAPP_VARIANTS = {"aimapp_revisits": {"track_anchors": False}}
 
 # How a run ends (the same rule for every study): AIMAPP by its own end of exploration
-# (cogmap.explore.Done: no map growth and no first visit for AIMAPP_PATIENCE decisions), a
+# (cogmap.explore.Done: its LiDAR map shows nothing reachable left to see for 3 decisions, or no
+# map growth and no first visit for AIMAPP_PATIENCE decisions), a
 # baseline when it declares itself finished (frontiers: no frontier left; oracle: no viewpoint
 # worth visiting), every method at the environment's decision budget. No coverage stop, so the
 # 90 % endpoint and the end of the run are both measured on the same run.

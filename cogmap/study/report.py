@@ -106,8 +106,9 @@ def protocol_note(plan, results, endpoint: str, success: bool = True) -> str:
 
     rule = plan.get("stop_rule", "?")
     if rule == STOP_RULE:
-        rule += (f" (AIMAPP's own end: no map growth and no first visit for {plan.get('aimapp_patience', 20)} "
-                 "decisions; frontiers: no frontier left; oracle: nothing worth a detour; random walk: budget only)")
+        rule += (" (AIMAPP's own end: its LiDAR map shows nothing reachable left to see for 3 decisions, or no map "
+                 f"growth and no first visit for {plan.get('aimapp_patience', 20)} decisions; frontiers: no frontier "
+                 "left; oracle: nothing worth a detour; random walk: budget only)")
     lines = [f"**Endpoint:** {endpoint}",
              f"**Run end:** {rule}. Budgets (decisions): " + ", ".join(f"{e} {n}" for e, n in plan["steps"].items())
              + ".",
