@@ -221,14 +221,13 @@ class Done:
     def __call__(self, decision) -> bool:
         a = self.agent
         seen = (a.num_states, int(a.visited().sum())) if a.model is not None else (0, 0)
-        if getattr(decision, "missing", ()):
+        if decision.missing:
             self.seen = seen
             return False
         self.quiet = self.quiet + 1 if seen == self.seen else 0
         self.seen = seen
-        views = getattr(a, "views", None)
-        nothing_left = (getattr(decision, "mode", "") == "explore" and a.cfg.view_weighting and views is not None
-                        and views.grid is not None and getattr(views, "target", -1) < 0)
+        nothing_left = (decision.mode == "explore" and a.cfg.view_weighting and a.views.grid is not None
+                        and a.views.target < 0)
         self.seen_all = self.seen_all + 1 if nothing_left else 0
         return self.finished
 

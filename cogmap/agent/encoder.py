@@ -192,13 +192,9 @@ class SSIMEncoder:
         x = _gray(image)
         best = (-1, 0, 0.0)
         for k in np.atleast_1d(np.asarray(ids, dtype=int)):
-            corr = column_shift_scores(x, self._x[k])
-            shifts = signed_shifts(max_shift, x.shape[1])
-            top = shifts[np.argsort(-corr[shifts % x.shape[1]], kind="stable")[:refine]]
-            for s in top:
-                score = float(self.scores(np.roll(x, int(s), axis=1), [k])[0])
-                if score > best[2]:
-                    best = (int(k), int(s), score)
+            shift, score = best_shift(x, self._x[k], max_shift, refine)
+            if score > best[2]:
+                best = (int(k), shift, score)
         return best
 
     def candidates(self, image: np.ndarray) -> np.ndarray:

@@ -30,7 +30,7 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
         return states
     steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth)[states].astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
-    last = getattr(agent.views, "target", -1)
+    last = agent.views.target
     keep = int(np.flatnonzero(states == last)[0]) if last >= 0 and (states == last).any() else -1
     i = sensed.best_target(gains, steps + beyond / cfg.influence_radius, cfg.influence_radius, cfg.view_detour,
                            keep=keep, keep_ratio=cfg.view_keep_ratio)
@@ -54,9 +54,8 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
         goal_states = agent.goal_states()
     else:
         objective, goal_states = efe.exploration(), None
-        views = getattr(agent, "views", None)
-        seen_from = agent.scanned_from() if hasattr(agent, "scanned_from") else agent.visited()
-        areas = views.areas(agent.poses, seen_from) if views is not None and cfg.view_weighting else None
+        views, seen_from = agent.views, agent.scanned_from()
+        areas = views.areas(agent.poses, seen_from) if cfg.view_weighting else None
         if areas is not None:  # what the LiDAR has sensed weights the information gain; informative states pull
             goal_states = _target(agent, state, *views.candidates(agent.poses, seen_from, areas))
             if goal_states.size:

@@ -48,6 +48,13 @@ def _noise(spec):
     return OdometryNoise(**spec["noise"]) if spec.get("noise") else None
 
 
+def _faults(spec) -> list[tuple[str, int, int]]:
+    """The dropout study's silent stream: ``(stream, first silent decision, length)``, or none."""
+    if spec["study"] != "dropout" or spec["level"] in (None, "none"):
+        return []
+    return [(spec["level"], spec["params"]["fault_start"], spec["params"]["fault_length"])]
+
+
 def study_sim(env: str, cfg, seed: int, noise=None):
     """A simulator whose start is seed ``seed``'s own (``cogmap.starts.seed_start`` via
     ``cogmap.explore.make_sim``): every seed starts somewhere else, as in the paper."""
@@ -133,7 +140,8 @@ def exploration_result(spec, sim, ep, ended_by_itself: bool = False) -> dict:
         "distance_m": m["distance_m"], "steps": m["steps"], "ce": ends["end"]["ce"], "nauc": ends["end"]["nauc"],
         "nauc_budget_m": budget, "nauc_own_distance": m["nauc"],
         "at_level": ends["at_level"], "level_step": ends["level_index"], "ended_by_itself": ended_by_itself,
-        "failed_moves": m["failed_moves"], "interventions": events, "mismatch_m": mismatch_m,
+        "failed_moves": m["failed_moves"], "silent_decisions": sum(1 for r in ep.rows if r.get("missing")),
+        "interventions": events, "mismatch_m": mismatch_m,
         "success": not events,
         "num_states": m["num_states"], "num_observations": m["num_observations"],
         "decision_mean_ms": m["decision_ms_mean"], "decision_p95_ms": m["decision_ms_p95"],
@@ -152,35 +160,19 @@ def _identity(sim, ep) -> dict:
 
 def run_exploration(spec) -> dict:
     opts = spec["method_options"]
-    # AIMAPP runs with default_config(env), which is what its spec records; a baseline's recorded config is used
+    # AIMAPP runs with aimapp_config(method, env), which is what its spec records; a baseline's recorded config
     config = opts.get("config") if not spec["method"].startswith("aimapp") else None
     sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
-                                        opts.get("patience"), config)
+                                        opts.get("patience"), config, _faults(spec))
     try:
         return exploration_result(spec, sim, ep, ended)
     finally:
         sim.close()
 
 
-def run_dropout(spec) -> dict:
-    """Exploration with one stream ("lidar" or "camera") silent for ``fault_length`` decisions
-    from decision ``fault_start`` (level "none": no fault)."""
-    p = spec["params"]
-    faults = [] if spec["level"] == "none" else [(spec["level"], p["fault_start"], p["fault_length"])]
-    opts = spec["method_options"]
-    sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], None,
-                                        opts.get("patience"), None, faults)
-    try:
-        out = exploration_result(spec, sim, ep, ended)
-        out.pop("curve", None)
-        out["level"] = spec["level"]
-        out["silent_decisions"] = int(sum(1 for r in ep.rows if r.get("missing")))
-        return out
-    finally:
-        sim.close()
-
-
 def run_drift(spec) -> dict:
+    """One exploration run of a level (odometry noise: drift and slip studies; silent stream:
+    dropout study), without its coverage curve."""
     out = run_exploration(spec)
     out.pop("curve", None)
     out["level"] = spec["level"]
@@ -349,7 +341,7 @@ def run_scaling(spec) -> dict:
 
 
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
-           "slip": run_drift, "dropout": run_dropout, "obstacle": run_obstacle, "scaling": run_scaling}
+           "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling}
 
 
 _DIGEST: str | None = None
