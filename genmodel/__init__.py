@@ -1,8 +1,9 @@
 """Generative-model specifications, compilation, growth, persistence and the map graph."""
 
 from .compile import compile
+from .likelihood import SparseLikelihood
 from .model import Model, PoseModel
-from .spec import Factor, InductiveSpec, Modality, ModelSpec, PoseSpec, SparseB, SpecError, normalise
+from .spec import Factor, InductiveSpec, Modality, ModelSpec, PoseSpec, SparseA, SparseB, SpecError, normalise
 from .transitions import SparseTransitions
 
 __all__ = [
@@ -13,7 +14,9 @@ __all__ = [
     "ModelSpec",
     "PoseModel",
     "PoseSpec",
+    "SparseA",
     "SparseB",
+    "SparseLikelihood",
     "SparseTransitions",
     "SpecError",
     "compile",

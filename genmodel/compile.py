@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .likelihood import SparseLikelihood
 from .model import Model, PoseModel
-from .spec import Factor, Modality, ModelSpec, SparseB, SpecError
+from .spec import Factor, Modality, ModelSpec, SparseA, SparseB, SpecError
 from .transitions import SparseTransitions
 
 ATOL = 1e-6
@@ -113,11 +114,17 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
     for mod in spec.modalities:
         shape = (mod.size,) + tuple(factors[d].size for d in mod.depends_on)
         what = f"A['{mod.name}']"
+        cap_shape = (cap_m[mod.name],) + tuple(cap_f[d] for d in mod.depends_on)
+        A_deps.append(tuple(order_f.index(d) for d in mod.depends_on))
+        C.append(_preferences(spec, mod, cap_m[mod.name]))
+        if isinstance(spec.A[mod.name], SparseA):
+            A.append(_sparse_A_from_spec(spec, mod, factors, cap_shape))
+            pA.append(None)
+            continue
         a = _array(spec.A[mod.name], what)
         if a.shape != shape:
             raise SpecError(f"{what}: shape {a.shape}, expected {shape} (outcomes, *depends_on)")
         _check_normalised(a, what)
-        cap_shape = (cap_m[mod.name],) + tuple(cap_f[d] for d in mod.depends_on)
         full = np.zeros(cap_shape)
         full[tuple(slice(0, n) for n in shape)] = a
         _fill_dead_columns(full, shape)
@@ -133,16 +140,6 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
             pA.append(pfull)
         else:
             pA.append(None)
-        c = np.zeros(cap_m[mod.name])
-        if mod.name in spec.C:
-            cv = np.asarray(spec.C[mod.name], dtype=float)
-            if cv.shape != (mod.size,):
-                raise SpecError(f"C['{mod.name}']: shape {cv.shape}, expected ({mod.size},)")
-            if not np.all(np.isfinite(cv)):
-                raise SpecError(f"C['{mod.name}']: contains NaN or infinite entries")
-            c[: mod.size] = cv
-        C.append(c)
-        A_deps.append(tuple(order_f.index(d) for d in mod.depends_on))
 
     B, pB, D, C_states = [], [], [], []
     for fac in spec.factors:
@@ -155,6 +152,14 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
             if counts.shape != (n, n, u):
                 raise SpecError(f"pB['{fac.name}']: shape {counts.shape}, expected {(n, n, u)}")
         if isinstance(raw, SparseB):
+            if raw.counts is not None:
+                if counts is not None:
+                    raise SpecError(f"pB['{fac.name}']: the SparseB holds its own counts; give them once")
+                counts = _array(raw.counts, f"{what}.counts")
+                if counts.shape != np.shape(raw.prob):
+                    raise SpecError(f"{what}.counts: shape {counts.shape}, expected {np.shape(raw.prob)} (as prob)")
+                if np.any(counts < 0):
+                    raise SpecError(f"{what}.counts: negative count")
             B.append(_sparse_from_spec(raw, fac, cap, counts))
             pB.append(None)
         else:
@@ -218,6 +223,45 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
     )
 
 
+def _preferences(spec: ModelSpec, mod: Modality, cap: int) -> np.ndarray:
+    c = np.zeros(cap)
+    if mod.name in spec.C:
+        cv = np.asarray(spec.C[mod.name], dtype=float)
+        if cv.shape != (mod.size,):
+            raise SpecError(f"C['{mod.name}']: shape {cv.shape}, expected ({mod.size},)")
+        if not np.all(np.isfinite(cv)):
+            raise SpecError(f"C['{mod.name}']: contains NaN or infinite entries")
+        c[: mod.size] = cv
+    return c
+
+
+def _sparse_A_from_spec(spec: ModelSpec, mod: Modality, factors, cap_shape) -> SparseLikelihood:
+    what = f"A['{mod.name}']"
+    raw = spec.A[mod.name]
+    if len(mod.depends_on) != 1:
+        raise SpecError(f"{what}: a SparseA depends on exactly one factor, not {len(mod.depends_on)}")
+    if mod.name in spec.pA:
+        raise SpecError(f"pA['{mod.name}']: a SparseA holds its own counts; give them once, in A['{mod.name}']")
+    n = factors[mod.depends_on[0]].size
+    prior = _array(raw.prior, f"{what}.prior")
+    if prior.shape != (n,):
+        raise SpecError(f"{what}.prior: shape {prior.shape}, expected ({n},) (one concentration per state)")
+    o_idx, s_idx = np.asarray(raw.outcomes).ravel(), np.asarray(raw.states).ravel()
+    counts = np.asarray(raw.counts, dtype=float).ravel()
+    if not (o_idx.size == s_idx.size == counts.size):
+        raise SpecError(f"{what}: outcomes, states and counts must have the same length")
+    if o_idx.size and (not np.issubdtype(o_idx.dtype, np.integer) or not np.issubdtype(s_idx.dtype, np.integer)):
+        raise SpecError(f"{what}: outcomes and states must be integer indices")
+    if o_idx.size and (o_idx.min() < 0 or o_idx.max() >= mod.size or s_idx.min() < 0 or s_idx.max() >= n):
+        raise SpecError(f"{what}: an index is out of range (outcomes 0..{mod.size - 1}, states 0..{n - 1})")
+    if not np.all(np.isfinite(counts)) or np.any(counts < 0):
+        raise SpecError(f"{what}.counts: must be finite and non-negative")
+    total = prior + np.bincount(s_idx.astype(np.int64), weights=counts, minlength=n)
+    if np.any(total <= 0):
+        raise SpecError(f"{what}: state {int(np.flatnonzero(total <= 0)[0])} has no positive count")
+    return SparseLikelihood.from_counts(prior, (mod.size, o_idx, s_idx, counts), capacity=cap_shape[1])
+
+
 def _fill_dead_columns(full: np.ndarray, live_shape: tuple[int, ...]) -> None:
     """Columns of not-yet-live states get a uniform distribution over live outcomes."""
     n_o = live_shape[0]
@@ -244,13 +288,12 @@ def _sparse_from_spec(raw: SparseB, fac: Factor, cap: int, counts) -> SparseTran
     out = SparseTransitions.empty(cap, u, succ.shape[2], with_counts=counts is not None)
     out.succ[:n] = succ
     out.prob[:n] = prob
-    if counts is not None:
-        out.counts[:n] = 0.0
-        for a in range(u):
-            for s in range(n):
-                for k in range(succ.shape[2]):
-                    if prob[s, a, k] > 0:
-                        out.counts[s, a, k] = counts[succ[s, a, k], s, a]
+    if counts is not None and counts.shape == prob.shape:  # sparse counts, slot by slot
+        out.counts[:n] = counts
+    elif counts is not None:  # dense (n, n, u) counts read at the successors
+        s_idx = np.arange(n)[:, None, None]
+        a_idx = np.arange(u)[None, :, None]
+        out.counts[:n] = np.where(prob > 0, counts[succ, s_idx, a_idx], 0.0)
     if fac.stay is not None:
         stay_ok = np.all(
             np.isclose(out.prob[:n, fac.stay][np.arange(n), 0], 1.0)

@@ -30,13 +30,15 @@ def to_graph(
     pose = model.pose if model.pose is not None and model.pose.factor == factor else None
     A = None
     if modality is not None and model.modalities and model.A_deps[modality] == (factor,):
-        A = model.live_A(modality)
+        A = model.A[modality] if model.is_sparse_A(modality) else model.live_A(modality)
     for s in range(n):
         attrs = {}
         if pose is not None:
             attrs["x"], attrs["y"] = float(pose.poses[s, 0]), float(pose.poses[s, 1])
         if A is not None:
-            attrs["obs"] = ",".join(str(o) for o in np.flatnonzero(A[:, s] >= obs_threshold))
+            obs = A.outcomes_above(s, obs_threshold) if model.is_sparse_A(modality) else np.flatnonzero(
+                A[:, s] >= obs_threshold)
+            attrs["obs"] = ",".join(str(o) for o in obs)
         g.add_node(s, **attrs)
     stay = model.factors[factor].stay
     B = model.B[factor]

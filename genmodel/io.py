@@ -14,12 +14,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .likelihood import SparseLikelihood
 from .model import Model, PoseModel
 from .spec import Factor, InductiveSpec, Modality, SpecError
 from .transitions import SparseTransitions
 
 FORMAT = "cogmap-model"
-VERSION = 1
+VERSION = 2  # 2: sparse likelihoods (SparseA) saved as their counts; version 1 files still load
+READABLE = (1, 2)
 
 
 class ModelFileError(SpecError):
@@ -38,8 +40,15 @@ def save(model: Model, path) -> tuple[Path, Path]:
     npz_path.parent.mkdir(parents=True, exist_ok=True)
     arrays: dict[str, np.ndarray] = {}
     for m in range(len(model.modalities)):
-        arrays[f"A{m}"] = model.live_A(m)
         arrays[f"C{m}"] = model.live_C(m)
+        if model.is_sparse_A(m):  # the counts only: A is their normalisation
+            L = model.A[m]
+            n = L.num_states
+            arrays[f"Aprior{m}"] = L.prior[:n]
+            arrays[f"Aobs{m}"] = L.obs[:n]
+            arrays[f"Acnt{m}"] = L.cnt[:n]
+            continue
+        arrays[f"A{m}"] = model.live_A(m)
         if model.pA[m] is not None:
             arrays[f"pA{m}"] = model.live_pA(m)
     for f in range(len(model.factors)):
@@ -70,6 +79,7 @@ def save(model: Model, path) -> tuple[Path, Path]:
         "num_obs": list(model.num_obs),
         "A_deps": [list(d) for d in model.A_deps],
         "sparse": [model.is_sparse(f) for f in range(len(model.factors))],
+        "sparse_A": [model.is_sparse_A(m) for m in range(len(model.modalities))],
         "capacities": [model.state_capacity(f) for f in range(len(model.factors))],
         "obs_capacities": [model.obs_capacity(m) for m in range(len(model.modalities))],
         "prior_count": model.prior_count,
@@ -102,8 +112,9 @@ def load(path) -> Model:
         raise ModelFileError(f"{json_path}: not valid JSON ({err})") from None
     if not isinstance(meta, dict) or meta.get("format") != FORMAT:
         raise ModelFileError(f"{json_path}: not a cogmap model description")
-    if meta.get("version") != VERSION:
-        raise ModelFileError(f"{json_path}: format version {meta.get('version')} is not supported")
+    if meta.get("version") not in READABLE:
+        raise ModelFileError(f"{json_path}: format version {meta.get('version')} is not supported "
+                             f"(this cogmap reads versions {', '.join(map(str, READABLE))})")
     digest = hashlib.sha256(npz_path.read_bytes()).hexdigest()
     if digest != meta.get("npz_sha256"):
         raise ModelFileError(f"{npz_path}: contents do not match {json_path.name} (truncated or corrupt)")
@@ -133,7 +144,15 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
     caps, ocaps = meta["capacities"], meta["obs_capacities"]
     deps = tuple(tuple(d) for d in meta["A_deps"])
     A, pA, C = [], [], []
+    sparse_A = meta.get("sparse_A", [False] * len(deps))
     for m, d in enumerate(deps):
+        c = np.zeros(ocaps[m])
+        c[: no[m]] = _check(arrays[f"C{m}"], (no[m],), f"C{m}")
+        C.append(c)
+        if sparse_A[m]:
+            A.append(_sparse_likelihood(arrays, m, no[m], ns[d[0]], caps[d[0]]))
+            pA.append(None)
+            continue
         shape = (ocaps[m],) + tuple(caps[f] for f in d)
         live = (slice(0, no[m]),) + tuple(slice(0, ns[f]) for f in d)
         a = np.zeros(shape)
@@ -149,9 +168,6 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
             pA.append(p)
         else:
             pA.append(None)
-        c = np.zeros(ocaps[m])
-        c[: no[m]] = _check(arrays[f"C{m}"], (no[m],), f"C{m}")
-        C.append(c)
     B, pB, D, Cs = [], [], [], []
     for f, fac in enumerate(factors):
         n, cap, u = ns[f], caps[f], fac.num_controls
@@ -211,6 +227,21 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
     return model
 
 
+def _sparse_likelihood(arrays: dict, m: int, num_obs: int, n: int, cap: int) -> SparseLikelihood:
+    obs = arrays[f"Aobs{m}"]
+    if obs.ndim != 2 or obs.shape[0] != n or obs.dtype.kind not in "iu":
+        raise ModelFileError(f"array Aobs{m}: shape {obs.shape} ({obs.dtype}), expected integers ({n}, slots)")
+    cnt = _check(arrays[f"Acnt{m}"], obs.shape, f"Acnt{m}")
+    prior = _check(arrays[f"Aprior{m}"], (n,), f"Aprior{m}")
+    if obs.size and (obs.min() < -1 or obs.max() >= num_obs):
+        raise ModelFileError(f"array Aobs{m}: outcome index out of range (0..{num_obs - 1}, -1 for free)")
+    if np.any(cnt < 0) or np.any(prior < 0) or np.any((obs < 0) & (cnt != 0)):
+        raise ModelFileError(f"arrays Acnt{m}/Aprior{m}: negative counts or counts in free slots")
+    ok = obs >= 0
+    s_idx = np.nonzero(ok)[0]
+    return SparseLikelihood.from_counts(prior, (num_obs, obs[ok], s_idx, cnt[ok]), capacity=max(cap, n, 1))
+
+
 def _check(arr: np.ndarray, shape: tuple, name: str) -> np.ndarray:
     if arr.shape != tuple(shape):
         raise ModelFileError(f"array {name}: shape {arr.shape}, expected {tuple(shape)}")
@@ -221,6 +252,10 @@ def _check(arr: np.ndarray, shape: tuple, name: str) -> np.ndarray:
 
 def _check_normalised(model: Model) -> None:
     for m in range(len(model.modalities)):
+        if model.is_sparse_A(m):
+            if np.any(model.A[m].total() <= 0):
+                raise ModelFileError(f"likelihood '{model.modalities[m].name}': a column has no positive count")
+            continue
         a = model.live_A(m)
         if a.size and not np.allclose(a.sum(axis=0), 1.0, atol=1e-6):
             raise ModelFileError(f"likelihood '{model.modalities[m].name}': columns not normalised")

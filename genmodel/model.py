@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .likelihood import SparseLikelihood
 from .spec import Factor, InductiveSpec, Modality, SpecError
 from .transitions import SparseTransitions
 
@@ -44,7 +45,7 @@ class Model:
 
     factors: tuple[Factor, ...]
     modalities: tuple[Modality, ...]
-    A: list[np.ndarray]
+    A: list  # np.ndarray (obs_cap, *state_caps) or SparseLikelihood (counts inside, pA[m] None)
     A_deps: tuple[tuple[int, ...], ...]
     B: list  # np.ndarray (cap, cap, u) or SparseTransitions
     C: list[np.ndarray]
@@ -98,7 +99,7 @@ class Model:
         return self.D[f].shape[0]
 
     def obs_capacity(self, m: int) -> int:
-        return self.A[m].shape[0]
+        return self.C[m].shape[0]
 
     def state_mask(self, f: int) -> np.ndarray:
         mask = np.zeros(self.state_capacity(f), dtype=bool)
@@ -113,12 +114,39 @@ class Model:
     def is_sparse(self, f: int) -> bool:
         return isinstance(self.B[f], SparseTransitions)
 
+    def is_sparse_A(self, m: int) -> bool:
+        return isinstance(self.A[m], SparseLikelihood)
+
+    def has_counts_A(self, m: int) -> bool:
+        """Whether modality ``m`` carries Dirichlet counts (learnable)."""
+        return self.is_sparse_A(m) or self.pA[m] is not None
+
+    def A_row(self, m: int, o: int) -> np.ndarray:
+        """``A[m][o]`` over the live states (the evidence of outcome ``o``)."""
+        if self.is_sparse_A(m):
+            return self.A[m].row(o)
+        idx = (o,) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
+        return self.A[m][idx]
+
+    def pA_row(self, m: int, o: int) -> np.ndarray:
+        """Counts ``pA[m][o]`` over the live states."""
+        if self.is_sparse_A(m):
+            return self.A[m].counts_row(o)
+        if self.pA[m] is None:
+            raise SpecError(f"modality '{self.modalities[m].name}' has no pA counts")
+        idx = (o,) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
+        return self.pA[m][idx]
+
     # -- live views (copies trimmed to live sizes: references, export, tests) ---------------
     def live_A(self, m: int) -> np.ndarray:
+        if self.is_sparse_A(m):
+            return self.A[m].to_dense()
         idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
         return self.A[m][idx]
 
     def live_pA(self, m: int) -> np.ndarray | None:
+        if self.is_sparse_A(m):
+            return self.A[m].counts_dense()
         if self.pA[m] is None:
             return None
         idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
@@ -155,7 +183,8 @@ class Model:
         """Add one state to a growable factor; returns its index.
 
         The new state's likelihood columns are uniform over live outcomes with ``obs_count``
-        Dirichlet counts per outcome (default ``prior_count``), its transitions self-loop with
+        Dirichlet counts per outcome (default ``prior_count``; a sparse likelihood keeps that
+        total, ``obs_count x live outcomes``, spread over however many outcomes exist), its transitions self-loop with
         ``prior_count`` counts, the stay control stays the identity, no existing count changes,
         and every column stays normalised. ``pose`` (x, y) is stored when the model has a pose
         factor.
@@ -170,8 +199,11 @@ class Model:
         for m, deps in enumerate(self.A_deps):
             if f not in deps:
                 continue
-            axis = 1 + deps.index(f)
             n_o = self.num_obs[m]
+            if self.is_sparse_A(m):
+                self.A[m].add_state((self.prior_count if obs_count is None else obs_count) * n_o)
+                continue
+            axis = 1 + deps.index(f)
             col = [slice(None)] * self.A[m].ndim
             col[axis] = s
             col = tuple(col)
@@ -206,12 +238,23 @@ class Model:
 
         With Dirichlet counts, every live column gains ``count`` (default ``prior_count``) for
         the new outcome and is renormalised from its counts (existing counts unchanged); without
-        counts the new outcome starts with probability 0 everywhere.
+        counts the new outcome starts with probability 0 everywhere. A sparse likelihood spreads
+        each column's prior mass over one more outcome instead (O(1), ``count`` does not apply).
         """
         m = self.modality_index(modality)
         if not self.modalities[m].growable:
             raise SpecError(f"modality '{self.modalities[m].name}' is not growable")
         o = self.num_obs[m]
+        if self.is_sparse_A(m):
+            if count is not None:
+                raise SpecError(f"modality '{self.modalities[m].name}' is sparse: its columns keep their prior "
+                                "mass, spread over the outcomes; add_observation takes no count")
+            if o == self.obs_capacity(m):
+                self._grow_obs_capacity(m, 2 * max(1, o))
+            self.A[m].add_observation()
+            self.num_obs[m] = o + 1
+            self.C[m][o] = 0.0
+            return o
         if o == self.obs_capacity(m):
             self._grow_obs_capacity(m, 2 * max(1, o))
         self.num_obs[m] = o + 1
@@ -228,8 +271,8 @@ class Model:
         old = self.state_capacity(f)
         self.compile_count += 1
         for m, deps in enumerate(self.A_deps):
-            if f not in deps:
-                continue
+            if f not in deps or self.is_sparse_A(m):
+                continue  # a sparse likelihood reserves its own room
             axis = 1 + deps.index(f)
             self.A[m] = _pad_axis(self.A[m], axis, cap)
             if self.pA[m] is not None:
@@ -253,10 +296,12 @@ class Model:
 
     def _grow_obs_capacity(self, m: int, cap: int) -> None:
         self.compile_count += 1
+        self.C[m] = _pad_axis(self.C[m], 0, cap)
+        if self.is_sparse_A(m):
+            return
         self.A[m] = _pad_axis(self.A[m], 0, cap)
         if self.pA[m] is not None:
             self.pA[m] = _pad_axis(self.pA[m], 0, cap)
-        self.C[m] = _pad_axis(self.C[m], 0, cap)
 
 
 def _pad_axis(x: np.ndarray, axis: int, size: int) -> np.ndarray:

@@ -9,6 +9,7 @@ Conventions follow pymdp 1.0 without the batch axis:
 * ``B[f]`` has shape ``(num_states[f], num_states[f], num_controls[f])``; ``B[f][:, s, u]``
   is the distribution of the next state given state ``s`` and control ``u``.
   For large topological maps a :class:`SparseB` (padded successor lists) may be given instead.
+  A modality over one growable factor may be a :class:`SparseA` (counts only).
 * ``C[m]`` are log-preferences over outcomes (unnormalised, added to the expected utility).
 * ``D[f]`` is the initial belief.
 """
@@ -64,6 +65,21 @@ class SparseB:
 
     succ: Any
     prob: Any
+    counts: Any = None  # Dirichlet counts in the same layout (no dense (n, n, u) pB needed)
+
+
+@dataclass(frozen=True)
+class SparseA:
+    """A likelihood over one factor given by its Dirichlet counts, never as a dense array:
+    column ``s`` has a symmetric prior of total concentration ``prior[s]`` spread evenly over
+    the outcomes, plus learned ``counts`` at the ``(outcomes[i], states[i])`` pairs. ``A`` is
+    the normalised counts. Growth and learning cost O(1) per step
+    (:class:`~cogmap.genmodel.likelihood.SparseLikelihood`)."""
+
+    prior: Any
+    outcomes: Any = ()
+    states: Any = ()
+    counts: Any = ()
 
 
 @dataclass(frozen=True)

@@ -182,8 +182,10 @@ def modality_evidence(model, m: int, value, t: int = 0) -> Evidence | None:
                 f"observations[{t}] for modality '{name}': index {o} out of range "
                 f"(live outcomes 0..{n_o - 1})"
             )
-        return Evidence(deps, model.A[m][(o,) + live], 0.0, name)
+        return Evidence(deps, model.A_row(m, o), 0.0, name)
     p = _check_distribution(value, n_o, model.obs_capacity(m), f"observations[{t}] for modality '{name}'")
+    if model.is_sparse_A(m):
+        return Evidence(deps, model.A[m].expected_row(p[:n_o]), 0.0, name)
     lik = np.tensordot(p, model.A[m][(slice(0, n_o),) + live], axes=(0, 0))
     return Evidence(deps, lik, 0.0, name)
 

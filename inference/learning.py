@@ -167,9 +167,14 @@ def _learn_dense(model: Model, f: int, s: int, u: int, target: int, lr: float, r
 def learn_observation(model: Model, modality: int, obs: int, qs: list[np.ndarray], lr: float = 1.0) -> None:
     """Dirichlet update of ``A[modality]`` towards ``obs`` under beliefs ``qs`` (live slices)."""
     m = model.modality_index(modality)
-    if model.pA[m] is None:
+    if not model.has_counts_A(m):
         raise SpecError(f"learn_observation: modality '{model.modalities[m].name}' has no pA counts")
     deps = model.A_deps[m]
+    if model.is_sparse_A(m):
+        if not isinstance(obs, int | np.integer):
+            raise SpecError("learn_observation: a sparse likelihood learns from an outcome index")
+        model.A[m].learn(int(obs), np.asarray(qs[deps[0]])[: model.num_states[deps[0]]], lr)
+        return
     deps_q = [np.asarray(qs[f])[: model.num_states[f]] for f in deps]
     n_o = model.num_obs[m]
     if len(deps) == 1:  # touch only the columns the belief reaches: O(outcomes x support)

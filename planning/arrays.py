@@ -53,6 +53,8 @@ class PlanningArrays:
         return hasattr(self.B[f], "succ")
 
     def live_A(self, m: int) -> np.ndarray:
+        if not isinstance(self.A[m], np.ndarray):  # sparse likelihood: densified (small models only)
+            return self.A[m].to_dense()
         idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
         return self.A[m][idx]
 
@@ -63,6 +65,8 @@ class PlanningArrays:
         return self.B[f][:n, :n]
 
     def live_pA(self, m: int):
+        if not isinstance(self.A[m], np.ndarray):
+            return self.A[m].counts_dense()
         if self.pA is None or self.pA[m] is None:
             return None
         idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
@@ -135,6 +139,15 @@ def from_model(
     )
 
 
+def as_arrays(model) -> PlanningArrays:
+    """:class:`PlanningArrays` as they are, or a compiled ``Model`` through :func:`from_model`."""
+    if isinstance(model, PlanningArrays):
+        return model
+    if hasattr(model, "factors") and hasattr(model, "A_deps"):
+        return from_model(model)
+    raise TypeError(f"planning needs a compiled Model or PlanningArrays, got {type(model).__name__}")
+
+
 @dataclass
 class Prepared:
     """Derived quantities for one decision (dense: full arrays; sparse: per-state caches)."""
@@ -150,6 +163,7 @@ class Prepared:
     _HA_cols: list = field(default_factory=list)
     _wA_cols: list = field(default_factory=list)
     _used: int = 0
+    need_novelty: bool = True
 
     # lazily filled column statistics for the sparse (single-factor) path
     def columns(self, U: np.ndarray) -> tuple[list, list]:
@@ -161,6 +175,8 @@ class Prepared:
             a = self.arrays
             k = np.arange(self._used, self._used + new.size)
             for m in range(len(a.A)):
+                if not isinstance(a.A[m], np.ndarray):
+                    continue  # a sparse likelihood computes its own column statistics
                 cols = a.A[m][: a.num_obs[m], new]
                 self._HA_cols[m][k] = entropy(cols, axis=0)
                 if self._wA_cols[m] is not None:
@@ -198,7 +214,7 @@ def prepare(
         local = a.num_factors == 1 and a.is_sparse(0)
     if local and not (a.num_factors == 1 and a.is_sparse(0)):
         raise ValueError("the local planning path needs a single factor with sparse transitions")
-    prep = Prepared(arrays=a, local=local)
+    prep = Prepared(arrays=a, local=local, need_novelty=need_novelty)
     if local:
         n = a.num_states[0]
         prep._slot = np.full(max(n, 1), -1, dtype=np.int64)
@@ -206,7 +222,7 @@ def prepare(
         prep._HA_cols = [np.zeros(cap) for _ in a.A]
         prep._wA_cols = [
             None
-            if (not need_novelty or a.pA is None or a.pA[m] is None)
+            if (not need_novelty or a.pA is None or a.pA[m] is None or not isinstance(a.A[m], np.ndarray))
             else np.zeros((a.num_obs[m], cap))
             for m in range(len(a.A))
         ]
@@ -231,4 +247,4 @@ def prepare(
     return prep
 
 
-__all__ = ["EPS", "PlanningArrays", "Prepared", "from_model", "prepare"]
+__all__ = ["EPS", "PlanningArrays", "Prepared", "as_arrays", "from_model", "prepare"]

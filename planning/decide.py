@@ -9,6 +9,7 @@ import numpy as np
 from . import efe
 from .arrays import PlanningArrays, from_model, prepare
 from .mcts import Decision, MCTSConfig, mcts
+from .threads import limited
 
 MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full, "sensed": efe.sensed_exploration}
 
@@ -69,4 +70,5 @@ def decide(
                                                 efe.sensed_info_gain)),
         need_goal=obj.uses(efe.inductive),
     )
-    return mcts(prep, qs, obj, obstacles, cfg, rng)
+    with limited():
+        return mcts(prep, qs, obj, obstacles, cfg, rng)

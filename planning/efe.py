@@ -53,8 +53,8 @@ def novelty_weights(counts: np.ndarray, axis: int = 0) -> np.ndarray:
 def state_info_gain(ctx) -> np.ndarray:
     """Epistemic value about states: ``sum_m H[Q(o_m)] - E_Q(s)[H[P(o_m|s)]]``."""
     out = np.zeros(ctx.num_candidates)
-    for qo, amb in zip(ctx.qo, ctx.ambiguity, strict=True):
-        out += entropy(qo) - amb
+    for h, amb in zip(ctx.outcome_entropy, ctx.ambiguity, strict=True):
+        out += h - amb
     return out
 
 
@@ -96,8 +96,8 @@ def sensed_info_gain(ctx) -> np.ndarray:
 def observation_preference(ctx) -> np.ndarray:
     """Expected log-preference over outcomes, ``sum_m Q(o_m) . C_m``."""
     out = np.zeros(ctx.num_candidates)
-    for qo, c in zip(ctx.qo, ctx.C, strict=True):
-        out += qo @ c
+    for u in ctx.outcome_utility:
+        out += u
     return out
 
 

@@ -7,9 +7,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .arrays import PlanningArrays, Prepared, prepare
+from .arrays import Prepared, as_arrays, prepare
 from .context import DenseStep
 from .efe import Objective
+from .threads import limited
 
 
 def enumerate_policies(
@@ -36,7 +37,7 @@ def obstacle_probability(obstacles, actions: np.ndarray, control_factor: int = 0
 
 
 def evaluate_policies(
-    arrays: PlanningArrays | Prepared,
+    arrays,
     qs: Sequence[np.ndarray],
     policies: np.ndarray,
     objective: Objective,
@@ -46,7 +47,12 @@ def evaluate_policies(
     """Expected free energy ``G(pi) = sum_tau G(pi, tau)`` of every policy (Eq. 5), rolling
     the factor beliefs ``qs`` forward under each policy; ``per_step`` also returns ``(P, T)``.
     The obstacle signal applies to the first step."""
-    prep = arrays if isinstance(arrays, Prepared) else prepare(arrays, local=False)
+    with limited():
+        return _evaluate(arrays, qs, policies, objective, obstacles, per_step)
+
+
+def _evaluate(arrays, qs, policies, objective, obstacles, per_step):
+    prep = arrays if isinstance(arrays, Prepared) else prepare(as_arrays(arrays), local=False)
     if prep.local:
         raise ValueError("evaluate_policies needs a dense preparation (prepare(..., local=False))")
     a = prep.arrays
@@ -92,7 +98,7 @@ def action_marginals(q: np.ndarray, policies: np.ndarray, num_controls: Sequence
 
 
 def infer_policies(
-    arrays: PlanningArrays | Prepared,
+    arrays,
     qs: Sequence[np.ndarray],
     objective: Objective,
     length: int = 1,
@@ -100,7 +106,9 @@ def infer_policies(
     obstacles=None,
     rng: np.random.Generator | None = None,
 ):
-    """Enumerate, evaluate and pick: returns ``(first_action (F,), q_pi, G, policies)``."""
+    """Enumerate, evaluate and pick: returns ``(first_action (F,), q_pi, G, policies)``.
+    ``arrays`` is a compiled ``Model``, :class:`PlanningArrays` or a :class:`Prepared`."""
+    arrays = arrays if isinstance(arrays, Prepared) else as_arrays(arrays)
     a = arrays.arrays if isinstance(arrays, Prepared) else arrays
     policies = enumerate_policies(a.num_controls, length)
     G = evaluate_policies(arrays, qs, policies, objective, obstacles)

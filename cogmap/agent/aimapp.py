@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseB, compile
+from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseA, SparseB, compile
 from cogmap.inference import bayes_filter
 from cogmap.inference.learning import Event, learn_observation, learn_transition
 from cogmap.inference.se2 import SE2, apply, apply_pose, compose, invert, rotate
@@ -88,10 +88,8 @@ def initial_model(cfg: AgentConfig, pose0) -> Model:
     spec = ModelSpec(
         factors=[Factor("place", 1, num_controls=u, growable=True, capacity=cfg.initial_capacity, stay=cfg.stay)],
         modalities=[Modality("view", 1, ("place",), growable=True, capacity=cfg.initial_capacity)],
-        A={"view": np.ones((1, 1))},
-        pA={"view": np.full((1, 1), cfg.prior_count)},
-        B={"place": SparseB(succ, prob)},
-        pB={"place": np.full((1, 1, u), cfg.prior_count)},
+        A={"view": SparseA(np.full(1, cfg.prior_count))},
+        B={"place": SparseB(succ, prob, counts=np.where(prob > 0, cfg.prior_count, 0.0))},
         pose=PoseSpec("place", np.asarray(pose0, dtype=float)[None, :2], headings, cfg.influence_radius,
                       cfg.influence_radius, cfg.sigma),
         inductive=InductiveSpec(cfg.inductive_threshold, cfg.inductive_depth, cfg.inductive_weight),
@@ -185,7 +183,7 @@ class AIMAPPAgent:
         """States whose observation model favours the goal observation."""
         if self.goal_obs is None:
             return np.zeros(0, dtype=int)
-        row = self.model.live_A(0)[self.goal_obs]
+        row = self.model.A_row(0, self.goal_obs)
         return np.flatnonzero(row >= max(min_prob * row.max(), 1e-9))
 
     def step(self, sensed: Sensed) -> Decision:
@@ -286,9 +284,9 @@ class AIMAPPAgent:
         obs, _ = self.encoder(panorama)
         self.last_obs = obs
         while self.model.num_obs[0] <= obs:
-            # a column's prior mass stays prior_count however many outcomes exist, so a taught
-            # column keeps its certainty as the vocabulary of views grows
-            self.model.add_observation(0, count=self.cfg.prior_count / (self.model.num_obs[0] + 1))
+            # a column's prior mass stays prior_count however many outcomes exist (SparseA), so a
+            # taught column keeps its certainty as the vocabulary of views grows
+            self.model.add_observation(0)
         return obs, float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
 
     def _infer(self, obs: int | None, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
@@ -304,7 +302,7 @@ class AIMAPPAgent:
         q = q[0]
         d2 = np.sum((self.poses - pose) ** 2, axis=1)
         near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are
-        row = None if obs is None else self.model.live_A(0)[obs]
+        row = None if obs is None else self.model.A_row(0, obs)
         conf = assess(q, near, row, cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
         return q, conf
 
@@ -388,7 +386,7 @@ class AIMAPPAgent:
 
     def visited(self) -> np.ndarray:
         """Mask of states whose observation model has been taught (the agent has been there)."""
-        return self.model.live_pA(0).max(axis=0) > 2 * self.cfg.prior_count
+        return self.model.A[0].taught(2 * self.cfg.prior_count)
 
     def _scan_agrees(self, sensed: Sensed, pose: np.ndarray) -> bool:
         """The LiDAR scan aligns, within the tracking gate, with the anchor of the nearest
@@ -427,7 +425,7 @@ class AIMAPPAgent:
     def _recognised(self, state: int, obs: int) -> bool:
         """``obs`` has been tied to ``state`` before and to no other state as strongly."""
         m = self.model
-        counts = m.live_pA(0)[obs]
+        counts = m.pA_row(0, obs)
         return counts[state] > 2 * self.cfg.prior_count and counts.argmax() == state
 
     def _visited_prior(self) -> np.ndarray:
