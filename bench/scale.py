@@ -9,8 +9,11 @@ For each size, in a fresh process (so peak memory is that size's own):
 2. the real agent steps in a numpy box world of the same size (exact odometry, the encoder names
    the 1 m cell), starting mid-map: time per agent step (sense -> infer -> learn -> plan) and per
    planning decision (MCTS, 30 simulations, depth 10, exploration objective), median and p95;
+   then half as many steps in goal mode (preferences and the inductive term, whose reachability
+   search runs over the whole map);
 3. on the grown model: amortised time of ``add_observation``, ``add_state`` (1,000 each), of one
-   A_o update and one B_s update, and the reallocations a 1,000-step growth performed;
+   A_o update (a view tied to a random place) and one B_s update, and the reallocations the
+   2,000 growth steps performed;
 4. peak resident memory of the process.
 
 The 500-state figures are the reference column (ratios beside the others). A last section times
@@ -99,32 +102,51 @@ def measure(n: int, steps: int, seed: int = 0) -> dict:
             d = agent.step(sensed)
             step_ms.append(1e3 * (time.perf_counter() - t))
             moved = world.act(d, agent.cfg.stay)
+        explore_ms = plan_ms[1:]
+        plan_ms.clear()
+        agent.set_goal(0)  # goal mode: preferences, inductive term over the whole map
+        for _ in range(steps // 2):
+            d = agent.step(world.sense(moved))
+            moved = world.act(d, agent.cfg.stay)
+        goal_ms = plan_ms[1:]
     finally:
         planner.decide = decide
     model, cfg = agent.model, agent.cfg
     grown = model.num_states[0]
 
-    def per_call(fn, k: int) -> float:
+    def per_call(fn, k: int, warm: bool = True) -> float:
+        for i in range(k // 10 if warm else 0):  # warm-up: first touches of freshly allocated memory
+            fn(i)
         t = time.perf_counter()
         for i in range(k):
             fn(i)
         return 1e3 * (time.perf_counter() - t) / k
 
-    q = np.zeros(model.num_states[0] + 1000)
-    q[grown // 2] = 1.0
-    learn_a = per_call(lambda i: learn_observation(model, 0, i % model.num_obs[0], [q], lr=1.0), 200)
+    rng = np.random.default_rng(1)
+    places = rng.integers(grown, size=200)
+    views = rng.integers(model.num_obs[0], size=200)
+    onehot = np.eye(1, grown + 2000, 0)[0]
+
+    def learn_view(i):  # a confident visit ties a view to a place (one-hot belief)
+        onehot[:] = 0.0
+        onehot[places[i]] = 1.0
+        learn_observation(model, 0, int(views[i]), [onehot], lr=cfg.obs_learning_rate)
+
+    learn_a = per_call(learn_view, 200)
     learn_b = per_call(lambda i: learn_transition(model, 0, grown // 2, i % 12, grown // 2 + 1, Event.POSSIBLE,
                                                   reverse_control=(i % 12 + 6) % 12, rates=cfg.learning), 200)
     before = model.compile_count + model.A[0].reallocations
-    add_obs = per_call(lambda i: model.add_observation(0), 1000)
-    add_state = per_call(lambda i: model.add_state(0, pose=(-1.0 - i, -1.0), obs_count=0.1 / model.num_obs[0]), 1000)
+    add_obs = per_call(lambda i: model.add_observation(0), 1000, warm=False)
+    add_state = per_call(lambda i: model.add_state(0, pose=(-1.0 - i, -1.0), obs_count=0.1 / model.num_obs[0]), 1000,
+                         warm=False)
     reallocs = model.compile_count + model.A[0].reallocations - before
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     pct = lambda x, p: float(np.percentile(x, p))  # noqa: E731
     return {
         "states": n, "states_after_run": grown, "build_s": build_s,
         "step_ms_median": pct(step_ms[1:], 50), "step_ms_p95": pct(step_ms[1:], 95),
-        "decision_ms_median": pct(plan_ms[1:], 50), "decision_ms_p95": pct(plan_ms[1:], 95),
+        "decision_ms_median": pct(explore_ms, 50), "decision_ms_p95": pct(explore_ms, 95),
+        "goal_decision_ms_median": pct(goal_ms, 50), "goal_decision_ms_p95": pct(goal_ms, 95),
         "learn_A_ms": learn_a, "learn_B_ms": learn_b,
         "add_observation_ms": add_obs, "add_state_ms": add_state, "reallocations_per_2000_growths": reallocs,
         "peak_rss_mb": peak_mb,
@@ -219,6 +241,8 @@ def main(argv=None) -> None:
     ref = results[0]
     cols = [("step_ms_median", "step ms (median)"), ("step_ms_p95", "step ms (p95)"),
             ("decision_ms_median", "decision ms (median)"), ("decision_ms_p95", "decision ms (p95)"),
+            ("goal_decision_ms_median", "goal decision ms (median)"),
+            ("goal_decision_ms_p95", "goal decision ms (p95)"),
             ("learn_A_ms", "A_o update ms"), ("learn_B_ms", "B_s update ms"),
             ("add_observation_ms", "add_observation ms"), ("add_state_ms", "add_state ms"),
             ("reallocations_per_2000_growths", "reallocations / 2,000 growths"), ("peak_rss_mb", "peak RSS MB")]

@@ -11,11 +11,12 @@ The model holds data only; the maths lives in pure functions (``cogmap.inference
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .likelihood import SparseLikelihood
+from .spatial import PoseIndex
 from .spec import Factor, InductiveSpec, Modality, SpecError
 from .transitions import SparseTransitions
 
@@ -30,6 +31,7 @@ class PoseModel:
     step: float
     influence_radius: float
     sigma: float
+    index: PoseIndex | None = field(default=None, repr=False)  # built on first use (Model.pose_index)
 
     def predict(self, pose: np.ndarray, control: int, stay: int | None) -> np.ndarray:
         """Pose after ``control`` from ``pose`` (the stay control keeps the pose)."""
@@ -170,6 +172,17 @@ class Model:
     def live_D(self, f: int) -> np.ndarray:
         return self.D[f][: self.num_states[f]]
 
+    def pose_index(self) -> PoseIndex:
+        """Grid hash of the stored poses of the pose factor (cells of one influence radius),
+        kept up to date by :meth:`add_state`."""
+        pm = self.pose
+        if pm is None:
+            raise SpecError("this model has no pose factor")
+        n = self.num_states[pm.factor]
+        if pm.index is None or pm.index.count != n or pm.index.poses is not pm.poses:
+            pm.index = PoseIndex(pm.poses, pm.influence_radius, n)
+        return pm.index
+
     def predict(self, f: int, q: np.ndarray, u: int) -> np.ndarray:
         """One-step prediction of factor ``f`` under control ``u`` (dense or sparse)."""
         B = self.B[f]
@@ -231,6 +244,8 @@ class Model:
             if pose is None:
                 raise SpecError(f"factor '{self.factors[f].name}' has poses: add_state needs pose=")
             self.pose.poses[s] = pose
+            if self.pose.index is not None and self.pose.index.count == s:
+                self.pose.index.add(s)
         return s
 
     def add_observation(self, modality: str | int = 0, count: float | None = None) -> int:
@@ -293,6 +308,8 @@ class Model:
         self.C_states[f] = _pad_axis(self.C_states[f], 0, cap)
         if self.pose is not None and self.pose.factor == f:
             self.pose.poses = _pad_axis(self.pose.poses, 0, cap)
+            if self.pose.index is not None:
+                self.pose.index.poses = self.pose.poses
 
     def _grow_obs_capacity(self, m: int, cap: int) -> None:
         self.compile_count += 1

@@ -161,8 +161,7 @@ class AIMAPPAgent:
 
     def localise_at(self, odometry) -> int:
         """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``."""
-        d = np.hypot(*(self.poses - self.believed_pose(odometry)).T)
-        s = int(np.argmin(d))
+        s, _ = self.model.pose_index().nearest(self.believed_pose(odometry))
         self.q = np.zeros(self.num_states)
         self.q[s] = 1.0
         self._shift_frame(self.poses[s] - self.believed_pose(odometry))
@@ -457,16 +456,18 @@ class AIMAPPAgent:
         """For each heading, the nearest state lying in that direction (bearing within half a
         heading sector, at most 1.5 influence radii away), or -1."""
         cfg = self.cfg
-        rel = self.poses - self.poses[state]
-        dist = np.hypot(*rel.T)
+        idx, dist = self.model.pose_index().near(self.poses[state], 1.5 * cfg.influence_radius)
+        keep = dist > 1e-9
+        idx, dist = idx[keep], dist[keep]
+        rel = self.poses[idx] - self.poses[state]
         bearing = np.arctan2(rel[:, 1], rel[:, 0])
         sector = np.pi / cfg.num_headings
         out = np.full(cfg.num_headings, -1)
         for h in range(cfg.num_headings):
             off = np.abs((bearing - 2 * np.pi * h / cfg.num_headings + np.pi) % (2 * np.pi) - np.pi)
-            ok = (off <= sector + 1e-9) & (dist > 1e-9) & (dist <= 1.5 * cfg.influence_radius)
+            ok = off <= sector + 1e-9
             if ok.any():
-                out[h] = int(np.flatnonzero(ok)[np.argmin(dist[ok])])
+                out[h] = int(idx[ok][np.argmin(dist[ok])])  # ties: the lowest index, as before
         return out
 
     def _path_blocked(self, heading: int, target: int, obstacles: np.ndarray, scan: np.ndarray | None,
@@ -519,7 +520,7 @@ class AIMAPPAgent:
             if created >= cfg.lookahead_nodes:
                 continue
             p_star = origin + cfg.influence_radius * direction(h, cfg.num_headings)
-            d_near = float(np.min(np.hypot(*(self.poses - p_star).T)))
+            d_near = self.model.pose_index().nearest(p_star)[1]
             if expansion_free_energies(np.array([d_near]), radius, cfg.sigma)[0] < 0:  # Eq. (7)
                 new = m.add_state(0, pose=p_star, obs_count=cfg.prior_count / m.num_obs[0])
                 created += 1

@@ -43,8 +43,9 @@ def dominance(q: np.ndarray) -> float:
     q = np.asarray(q, dtype=float)
     if q.size < 2:
         return np.inf
-    top2 = np.partition(q, -2)[-2:]
-    return float(np.log(max(top2[1], TINY)) - np.log(max(top2[0], TINY)))
+    i = int(np.argmax(q))  # two passes of max: np.partition is slow on long runs of equal values
+    second = max(q[:i].max(initial=0.0), q[i + 1:].max(initial=0.0))
+    return float(np.log(max(q[i], TINY)) - np.log(max(second, TINY)))
 
 
 def conflict(A_row: np.ndarray, nearby: np.ndarray) -> float:

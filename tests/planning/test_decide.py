@@ -70,3 +70,58 @@ def test_from_model_derives_goal_and_settings():
 def test_decide_rejects_unknown_mode():
     with pytest.raises(ValueError, match="unknown planning mode"):
         decide(_corridor_model(), np.eye(6)[0], mode="wander", config=MCTSConfig(simulations=2))
+
+
+def test_planning_takes_a_compiled_model_directly():
+    from cogmap.genmodel import Factor, Modality, ModelSpec, compile
+    from cogmap.planning import efe
+    from cogmap.planning.arrays import from_model
+    from cogmap.planning.policies import evaluate_policies, infer_policies
+
+    rng = np.random.default_rng(0)
+    A = rng.dirichlet(np.ones(3), size=4).T
+    B = np.stack([rng.dirichlet(np.ones(4), size=4).T for _ in range(2)], axis=2)
+    model = compile(ModelSpec(factors=[Factor("s", 4, num_controls=2)], modalities=[Modality("o", 3, ("s",))],
+                              A={"o": A}, B={"s": B}, C={"o": np.array([1.0, 0.0, -1.0])}))
+    qs = [np.full(4, 0.25)]
+    obj = efe.pymdp_like()
+    first, q, G, policies = infer_policies(model, qs, obj, length=2, gamma=1.0, rng=np.random.default_rng(0))
+    np.testing.assert_allclose(G, evaluate_policies(from_model(model), qs, policies, obj), atol=1e-14)
+    with pytest.raises(TypeError, match="compiled Model or PlanningArrays"):
+        infer_policies({"A": A}, qs, obj)
+
+
+def test_planning_calls_limit_blas_threads_and_the_limit_is_overridable(monkeypatch):
+    from planning_builders import random_dense
+    from threadpoolctl import threadpool_info
+
+    from cogmap.planning import efe, threads
+    from cogmap.planning.policies import evaluate_policies
+
+    seen = []
+
+    def spy(ctx):  # an EFE term that records the BLAS threads while planning runs
+        seen.append(min(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"))
+        return np.zeros(ctx.num_candidates)
+
+    arrays, _ = random_dense(np.random.default_rng(1))
+    obj = efe.objective([(spy, 1.0)])
+    policies = np.zeros((1, 1, 1), dtype=int)
+    outside = min(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas")
+    evaluate_policies(arrays, [np.full(4, 0.25)], policies, obj)
+    assert seen[-1] == 1
+    monkeypatch.setenv("COGMAP_PLANNING_THREADS", "0")
+    evaluate_policies(arrays, [np.full(4, 0.25)], policies, obj)
+    assert seen[-1] == outside
+    threads.set_threads(1)  # the explicit setting wins over the environment
+    try:
+        evaluate_policies(arrays, [np.full(4, 0.25)], policies, obj)
+        assert seen[-1] == 1
+    finally:
+        threads.set_threads(None)
+    assert min(i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas") == outside
+    monkeypatch.setenv("COGMAP_PLANNING_THREADS", "many")
+    with pytest.raises(ValueError, match="non-negative integer"):
+        threads.threads()
+    with pytest.raises(ValueError, match="non-negative integer"):
+        threads.set_threads(-1)
