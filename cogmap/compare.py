@@ -71,7 +71,7 @@ def generate_sequence(model, T: int, seed: int = 0) -> Sequence:
         states.append(s.copy())
         step = []
         for m, deps in enumerate(model.A_deps):
-            col = model.A[m][(slice(0, model.num_obs[m]),) + tuple(int(s[f]) for f in deps)]
+            col = model.live_A(m)[(slice(None),) + tuple(int(s[f]) for f in deps)]
             step.append(_sample(rng, col))
         if model.pose is not None:
             pm = model.pose

@@ -30,7 +30,7 @@ def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> 
         for a, b, data in g.edges(data=True):
             ax.plot(*poses[[a, b]].T, color="tab:blue", lw=0.4 + 2.0 * data["prob"], alpha=0.6, zorder=4)
         visited = agent.visited()
-        obs = agent.model.A[0].most_likely() if agent.model.is_sparse_A(0) else agent.model.live_A(0).argmax(axis=0)
+        obs = agent.model.A[0].most_likely()
         ax.scatter(*poses[~visited].T, s=18, facecolors="white", edgecolors="tab:blue", zorder=5,
                    label="predicted (unvisited) states")
         ax.scatter(*poses[visited].T, s=34, c=obs[visited], cmap="tab20", edgecolors="k", lw=0.5, zorder=6,

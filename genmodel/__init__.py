@@ -1,12 +1,14 @@
 """Generative-model specifications, compilation, growth, persistence and the map graph."""
 
 from .compile import compile
-from .likelihood import SparseLikelihood
+from .likelihood import DenseLikelihood, SparseLikelihood
 from .model import Model, PoseModel
 from .spec import Factor, InductiveSpec, Modality, ModelSpec, PoseSpec, SparseA, SparseB, SpecError, normalise
-from .transitions import SparseTransitions
+from .transitions import DenseTransitions, SparseTransitions
 
 __all__ = [
+    "DenseLikelihood",
+    "DenseTransitions",
     "Factor",
     "InductiveSpec",
     "Modality",

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .likelihood import SparseLikelihood
+from .likelihood import DenseLikelihood, SparseLikelihood
 from .model import Model, PoseModel
 from .spec import Factor, Modality, ModelSpec, SparseA, SparseB, SpecError
-from .transitions import SparseTransitions
+from .transitions import DenseTransitions, SparseTransitions
 
 ATOL = 1e-6
 
@@ -110,7 +110,7 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
         for m in spec.modalities
     }
 
-    A, pA, C, A_deps = [], [], [], []
+    A, C, A_deps = [], [], []
     for mod in spec.modalities:
         shape = (mod.size,) + tuple(factors[d].size for d in mod.depends_on)
         what = f"A['{mod.name}']"
@@ -119,7 +119,6 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
         C.append(_preferences(spec, mod, cap_m[mod.name]))
         if isinstance(spec.A[mod.name], SparseA):
             A.append(_sparse_A_from_spec(spec, mod, factors, cap_shape))
-            pA.append(None)
             continue
         a = _array(spec.A[mod.name], what)
         if a.shape != shape:
@@ -128,7 +127,7 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
         full = np.zeros(cap_shape)
         full[tuple(slice(0, n) for n in shape)] = a
         _fill_dead_columns(full, shape)
-        A.append(full)
+        pfull = None
         if mod.name in spec.pA:
             p = _array(spec.pA[mod.name], f"pA['{mod.name}']")
             if p.shape != shape:
@@ -137,11 +136,9 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
                 raise SpecError(f"pA['{mod.name}']: a column has no positive count")
             pfull = np.zeros(cap_shape)
             pfull[tuple(slice(0, n) for n in shape)] = p
-            pA.append(pfull)
-        else:
-            pA.append(None)
+        A.append(DenseLikelihood(full, pfull, mod.size, shape[1:]))
 
-    B, pB, D, C_states = [], [], [], []
+    B, D, C_states = [], [], []
     for fac in spec.factors:
         n, u, cap = fac.size, fac.num_controls, cap_f[fac.name]
         what = f"B['{fac.name}']"
@@ -161,7 +158,6 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
                 if np.any(counts < 0):
                     raise SpecError(f"{what}.counts: negative count")
             B.append(_sparse_from_spec(raw, fac, cap, counts))
-            pB.append(None)
         else:
             b = _array(raw, what)
             if b.shape != (n, n, u):
@@ -172,13 +168,11 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
             full = np.zeros((cap, cap, u))
             full[:n, :n] = b
             full[np.arange(n, cap), np.arange(n, cap), :] = 1.0
-            B.append(full)
+            pfull = None
             if counts is not None:
                 pfull = np.zeros((cap, cap, u))
                 pfull[:n, :n] = counts
-                pB.append(pfull)
-            else:
-                pB.append(None)
+            B.append(DenseTransitions(full, pfull))
         d = np.zeros(cap)
         if fac.name in spec.D:
             dv = _array(spec.D[fac.name], f"D['{fac.name}']")
@@ -211,8 +205,6 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
         B=B,
         C=C,
         D=D,
-        pA=pA,
-        pB=pB,
         C_states=C_states,
         num_states=[f.size for f in spec.factors],
         num_obs=[m.size for m in spec.modalities],

@@ -11,10 +11,8 @@ from __future__ import annotations
 from pathlib import Path
 
 import networkx as nx
-import numpy as np
 
 from .model import Model
-from .transitions import SparseTransitions
 
 
 def to_graph(
@@ -30,30 +28,21 @@ def to_graph(
     pose = model.pose if model.pose is not None and model.pose.factor == factor else None
     A = None
     if modality is not None and model.modalities and model.A_deps[modality] == (factor,):
-        A = model.A[modality] if model.is_sparse_A(modality) else model.live_A(modality)
+        A = model.A[modality]
     for s in range(n):
         attrs = {}
         if pose is not None:
             attrs["x"], attrs["y"] = float(pose.poses[s, 0]), float(pose.poses[s, 1])
         if A is not None:
-            obs = A.outcomes_above(s, obs_threshold) if model.is_sparse_A(modality) else np.flatnonzero(
-                A[:, s] >= obs_threshold)
-            attrs["obs"] = ",".join(str(o) for o in obs)
+            attrs["obs"] = ",".join(str(o) for o in A.outcomes_above(s, obs_threshold))
         g.add_node(s, **attrs)
     stay = model.factors[factor].stay
     B = model.B[factor]
     for u in range(model.factors[factor].num_controls):
         if u == stay:
             continue
-        if isinstance(B, SparseTransitions):
-            src = np.repeat(np.arange(n), B.slots)
-            dst, prob = B.succ[:n, u].ravel(), B.prob[:n, u].ravel()
-        else:
-            dst, src = np.nonzero(B[:n, :n, u] >= min_prob)
-            prob = B[dst, src, u]
-        for a, b, p in zip(src, dst, prob, strict=True):
-            if p >= min_prob and a != b:
-                g.add_edge(int(a), int(b), key=int(u), control=int(u), prob=float(p))
+        for a, b, p in zip(*B.control_edges(u, n, min_prob), strict=True):
+            g.add_edge(int(a), int(b), key=int(u), control=int(u), prob=float(p))
     return g
 
 

@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .likelihood import SparseLikelihood
+from .likelihood import DenseLikelihood, SparseLikelihood
 from .model import Model, PoseModel
 from .spec import Factor, InductiveSpec, Modality, SpecError
-from .transitions import SparseTransitions
+from .transitions import DenseTransitions, SparseTransitions
 
 FORMAT = "cogmap-model"
 VERSION = 2  # 2: sparse likelihoods (SparseA) saved as their counts; version 1 files still load
@@ -49,7 +49,7 @@ def save(model: Model, path) -> tuple[Path, Path]:
             arrays[f"Acnt{m}"] = L.cnt[:n]
             continue
         arrays[f"A{m}"] = model.live_A(m)
-        if model.pA[m] is not None:
+        if model.A[m].has_counts:
             arrays[f"pA{m}"] = model.live_pA(m)
     for f in range(len(model.factors)):
         n = model.num_states[f]
@@ -60,9 +60,9 @@ def save(model: Model, path) -> tuple[Path, Path]:
             if B.counts is not None:
                 arrays[f"Bcounts{f}"] = B.counts[:n]
         else:
-            arrays[f"B{f}"] = B[:n, :n]
-            if model.pB[f] is not None:
-                arrays[f"pB{f}"] = model.pB[f][:n, :n]
+            arrays[f"B{f}"] = B.to_dense(n)
+            if B.counts is not None:
+                arrays[f"pB{f}"] = B.counts_dense(n)
         arrays[f"D{f}"] = model.live_D(f)
         arrays[f"Cs{f}"] = model.C_states[f][:n]
     if model.pose is not None:
@@ -143,7 +143,7 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
     ns, no = list(meta["num_states"]), list(meta["num_obs"])
     caps, ocaps = meta["capacities"], meta["obs_capacities"]
     deps = tuple(tuple(d) for d in meta["A_deps"])
-    A, pA, C = [], [], []
+    A, C = [], []
     sparse_A = meta.get("sparse_A", [False] * len(deps))
     for m, d in enumerate(deps):
         c = np.zeros(ocaps[m])
@@ -151,7 +151,6 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
         C.append(c)
         if sparse_A[m]:
             A.append(_sparse_likelihood(arrays, m, no[m], ns[d[0]], caps[d[0]]))
-            pA.append(None)
             continue
         shape = (ocaps[m],) + tuple(caps[f] for f in d)
         live = (slice(0, no[m]),) + tuple(slice(0, ns[f]) for f in d)
@@ -161,14 +160,12 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
             dead = np.ones(shape[1:], dtype=bool)
             dead[live[1:]] = False
             a[: no[m], dead] = 1.0 / max(1, no[m])
-        A.append(a)
+        p = None
         if f"pA{m}" in arrays:
             p = np.zeros(shape)
             p[live] = _check(arrays[f"pA{m}"], a[live].shape, f"pA{m}")
-            pA.append(p)
-        else:
-            pA.append(None)
-    B, pB, D, Cs = [], [], [], []
+        A.append(DenseLikelihood(a, p, no[m], tuple(ns[f] for f in d)))
+    B, D, Cs = [], [], []
     for f, fac in enumerate(factors):
         n, cap, u = ns[f], caps[f], fac.num_controls
         if meta["sparse"][f]:
@@ -180,18 +177,15 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
             if t.counts is not None:
                 t.counts[:n] = _check(arrays[f"Bcounts{f}"], (n, u, k), f"Bcounts{f}")
             B.append(t)
-            pB.append(None)
         else:
             b = np.zeros((cap, cap, u))
             b[:n, :n] = _check(arrays[f"B{f}"], (n, n, u), f"B{f}")
             b[np.arange(n, cap), np.arange(n, cap), :] = 1.0
-            B.append(b)
+            p = None
             if f"pB{f}" in arrays:
                 p = np.zeros((cap, cap, u))
                 p[:n, :n] = _check(arrays[f"pB{f}"], (n, n, u), f"pB{f}")
-                pB.append(p)
-            else:
-                pB.append(None)
+            B.append(DenseTransitions(b, p))
         d = np.zeros(cap)
         d[:n] = _check(arrays[f"D{f}"], (n,), f"D{f}")
         D.append(d)
@@ -213,8 +207,6 @@ def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
         B=B,
         C=C,
         D=D,
-        pA=pA,
-        pB=pB,
         C_states=Cs,
         num_states=ns,
         num_obs=no,
@@ -262,6 +254,6 @@ def _check_normalised(model: Model) -> None:
     for f in range(len(model.factors)):
         n = model.num_states[f]
         B = model.B[f]
-        sums = B.prob[:n].sum(axis=2) if isinstance(B, SparseTransitions) else B[:n, :n].sum(axis=0)
+        sums = B.prob[:n].sum(axis=2) if isinstance(B, SparseTransitions) else B.to_dense(n).sum(axis=0)
         if sums.size and not np.allclose(sums, 1.0, atol=1e-6):
             raise ModelFileError(f"transitions '{model.factors[f].name}': columns not normalised")

@@ -1,6 +1,16 @@
-"""Sparse, growable observation likelihood for a modality that depends on one factor.
+"""Likelihood factors that own their Dirichlet counts: dense and sparse, same operations.
 
-Column ``s`` of ``A`` is the mean of a Dirichlet whose counts are a *symmetric prior* of total
+Both types hold ``A`` for one modality with its counts and offer: ``row`` / ``counts_row`` (the
+evidence of one outcome over the live states), ``expected_row`` (of a distribution over
+outcomes), ``to_dense`` / ``counts_dense``, ``learn`` (the Dirichlet update of Eq. 8),
+``add_state`` / ``add_observation`` / ``grow_*`` (growth into reserved room), and for
+single-factor modalities the planning statistics ``column_stats`` and ``mixture``.
+
+:class:`DenseLikelihood` stores ``A[o, s_1, ..., s_k]`` at capacity (pymdp layout).
+
+:class:`SparseLikelihood`, for a modality over one growable factor, stores counts only:
+
+column ``s`` of ``A`` is the mean of a Dirichlet whose counts are a *symmetric prior* of total
 concentration ``prior[s]`` spread evenly over the live outcomes, plus *learned counts* on the
 few outcomes that were ever observed at ``s``::
 
@@ -23,6 +33,10 @@ from __future__ import annotations
 import numpy as np
 from scipy.special import digamma
 
+from .capacity import pad_axis
+from .dirichlet import as_distribution, normalise_counts, update_pA
+from .spec import SpecError
+
 EPS = float(np.finfo(float).eps)
 SUPPORT_CUTOFF = 1e-12  # belief mass below which a learning update leaves a column alone
 
@@ -36,6 +50,138 @@ def _novelty(a: np.ndarray, a0: np.ndarray) -> np.ndarray:
     a = np.maximum(a, EPS)
     a0 = np.maximum(a0, EPS)
     return np.log(a0) - np.log(a) + digamma(a + 1.0) - digamma(a0 + 1.0)
+
+
+class DenseLikelihood:
+    """``A`` (outcomes x states of each dependency) at capacity, with optional counts."""
+
+    def __init__(self, prob: np.ndarray, counts: np.ndarray | None, num_obs: int, num_states: tuple[int, ...]):
+        self.prob = np.asarray(prob, dtype=float)
+        self.counts = None if counts is None else np.asarray(counts, dtype=float)
+        self.num_obs = int(num_obs)
+        self.num_states = tuple(int(n) for n in num_states)
+
+    @property
+    def has_counts(self) -> bool:
+        return self.counts is not None
+
+    @property
+    def obs_capacity(self) -> int:
+        return self.prob.shape[0]
+
+    def _live(self) -> tuple[slice, ...]:
+        return (slice(0, self.num_obs),) + tuple(slice(0, n) for n in self.num_states)
+
+    def to_dense(self) -> np.ndarray:
+        """The live block (a view)."""
+        return self.prob[self._live()]
+
+    def counts_dense(self) -> np.ndarray | None:
+        return None if self.counts is None else self.counts[self._live()]
+
+    def row(self, o: int) -> np.ndarray:
+        return self.prob[(o,) + self._live()[1:]]
+
+    def counts_row(self, o: int) -> np.ndarray:
+        if self.counts is None:
+            raise SpecError("this likelihood has no Dirichlet counts")
+        return self.counts[(o,) + self._live()[1:]]
+
+    def expected_row(self, p: np.ndarray) -> np.ndarray:
+        return np.tensordot(np.asarray(p, dtype=float)[: self.num_obs], self.to_dense(), axes=(0, 0))
+
+    def column(self, s: int) -> np.ndarray:
+        return self.prob[: self.num_obs, s].copy()
+
+    def learn(self, obs, qs: list[np.ndarray], lr: float = 1.0) -> None:
+        """Eq. (8): ``pA += lr * o (x) q(deps)``, then ``A`` renormalised where touched."""
+        if self.counts is None:
+            raise SpecError("this likelihood has no Dirichlet counts to learn")
+        n_o = self.num_obs
+        if len(qs) == 1:  # touch only the columns the belief reaches: O(outcomes x support)
+            q = np.asarray(qs[0], dtype=float)
+            cols = np.flatnonzero(q > 0)
+            o = as_distribution(obs, n_o)
+            block = self.counts[:n_o, cols] + lr * np.outer(o, q[cols])
+            block = np.where(o[:, None] > 0, np.maximum(block, 1e-3), block)
+            self.counts[:n_o, cols] = block
+            self.prob[:n_o, cols] = normalise_counts(block)
+            return
+        live = self._live()
+        new = update_pA(self.counts[live], obs, qs, lr)
+        self.counts[live] = new
+        self.prob[live] = normalise_counts(new)
+
+    # -- growth -----------------------------------------------------------------------------
+    def add_state(self, axis: int, count: float) -> None:
+        """A new state on dependency ``axis``: its columns uniform over the live outcomes, with
+        ``count`` Dirichlet counts per outcome."""
+        s = self.num_states[axis]
+        sizes = list(self.num_states)
+        sizes[axis] = s + 1
+        self.num_states = tuple(sizes)
+        col = [slice(None)] * self.prob.ndim
+        col[1 + axis] = s
+        col = tuple(col)
+        n_o = self.num_obs
+        self.prob[col] = 0.0
+        self.prob[col][:n_o] = 1.0 / max(1, n_o)
+        if self.counts is not None:
+            self.counts[col] = 0.0
+            self.counts[col][:n_o] = count
+
+    def add_observation(self, count: float) -> None:
+        """A new outcome: every live column gains ``count`` for it and is renormalised from its
+        counts (without counts it starts with probability 0 everywhere)."""
+        o = self.num_obs
+        self.num_obs = o + 1
+        live = self._live()[1:]
+        self.prob[(o,) + live] = 0.0
+        if self.counts is not None:
+            self.counts[(o,) + live] = count
+            counts = self.counts[(slice(0, o + 1),) + live]
+            self.prob[(slice(0, o + 1),) + live] = counts / counts.sum(axis=0, keepdims=True)
+
+    def grow_states(self, axis: int, capacity: int) -> None:
+        self.prob = pad_axis(self.prob, 1 + axis, capacity)
+        if self.counts is not None:
+            self.counts = pad_axis(self.counts, 1 + axis, capacity)
+
+    def grow_obs(self, capacity: int) -> None:
+        self.prob = pad_axis(self.prob, 0, capacity)
+        if self.counts is not None:
+            self.counts = pad_axis(self.counts, 0, capacity)
+
+    # -- single-factor queries ------------------------------------------------------------
+    def taught(self, threshold: float) -> np.ndarray:
+        return self.counts_dense().max(axis=0) > threshold
+
+    def most_likely(self) -> np.ndarray:
+        return self.to_dense().argmax(axis=0)
+
+    def outcomes_above(self, s: int, threshold: float) -> np.ndarray:
+        return np.flatnonzero(self.column(s) >= threshold)
+
+    def column_stats(self, states: np.ndarray, novelty: bool = True):
+        """As :meth:`SparseLikelihood.column_stats`, with every outcome a "slot"."""
+        states = np.asarray(states, dtype=np.int64)
+        cols = self.prob[: self.num_obs, states]
+        H = -_xlogx(cols).sum(axis=0)
+        zero = np.zeros(states.size)
+        if not novelty or self.counts is None:
+            return H, zero, np.zeros((states.size, self.num_obs))
+        a = self.counts[: self.num_obs, states]
+        w = np.where(a > 0, _novelty(a, a.sum(axis=0, keepdims=True)), 0.0)
+        return H, zero, w.T
+
+    def mixture(self, states: np.ndarray, qs: np.ndarray):
+        """As :meth:`SparseLikelihood.mixture`: every outcome is listed, none in the background."""
+        values = qs @ self.prob[: self.num_obs, np.asarray(states, dtype=np.int64)].T
+        return np.zeros(qs.shape[0]), np.arange(self.num_obs), values
+
+    def scatter_slots(self, states: np.ndarray, outcomes: np.ndarray, per_slot: np.ndarray) -> np.ndarray:
+        """As :meth:`SparseLikelihood.scatter_slots`: here slots are the outcomes themselves."""
+        return per_slot
 
 
 class SparseLikelihood:
@@ -74,6 +220,8 @@ class SparseLikelihood:
         return out
 
     # -- shape ------------------------------------------------------------------------------
+    has_counts = True
+
     @property
     def capacity(self) -> int:
         return self.prior.shape[0]
@@ -92,8 +240,14 @@ class SparseLikelihood:
         return self.prior[s] + self.learned_total[s]
 
     # -- growth -----------------------------------------------------------------------------
-    def add_state(self, concentration: float) -> int:
-        """A new column: the symmetric prior of total ``concentration``, nothing learned."""
+    def add_state(self, axis: int, count: float) -> int:
+        """A new column with ``count`` prior counts per live outcome (total concentration
+        ``count x num_obs``, spread over however many outcomes there will be), nothing learned."""
+        if axis != 0:
+            raise ValueError("a sparse likelihood depends on one factor (axis 0)")
+        return self._add_column(count * self.num_obs)
+
+    def _add_column(self, concentration: float) -> int:
         s = self.num_states
         if s == self.capacity:
             self._reallocate(2 * max(1, s), self.slots)
@@ -104,11 +258,23 @@ class SparseLikelihood:
         self.cnt[s] = 0.0
         return s
 
-    def add_observation(self) -> int:
-        """A new outcome; every column spreads its prior over one more outcome (O(1))."""
+    def add_observation(self, count: float | None = None) -> int:
+        """A new outcome; every column spreads its prior over one more outcome (O(1)). Columns
+        keep their prior mass, so a per-outcome ``count`` does not apply."""
+        if count is not None:
+            raise SpecError("a sparse likelihood's columns keep their prior mass, spread over the "
+                            "outcomes; add_observation takes no count")
         self.rows.append([])
         self.num_obs += 1
         return self.num_obs - 1
+
+    def grow_states(self, axis: int, capacity: int) -> None:
+        """Reserve room for ``capacity`` states (the model grows its factor)."""
+        if capacity > self.capacity:
+            self._reallocate(capacity, self.slots)
+
+    def grow_obs(self, capacity: int) -> None:
+        """Outcomes need no reserved room (nothing is stored per outcome and state)."""
 
     def _reallocate(self, capacity: int, slots: int) -> None:
         self.reallocations += 1
@@ -140,10 +306,12 @@ class SparseLikelihood:
         self.cnt[s, k] += value
         self.learned_total[s] += value
 
-    def learn(self, obs: int, q: np.ndarray, lr: float = 1.0) -> None:
-        """Dirichlet update ``pA[obs, s] += lr * q[s]`` for the states ``q`` reaches (mass above
-        ``SUPPORT_CUTOFF``: a smaller update changes no count by more than 1e-12)."""
-        q = np.asarray(q, dtype=float)[: self.num_states]
+    def learn(self, obs: int, qs: list[np.ndarray], lr: float = 1.0) -> None:
+        """Dirichlet update ``pA[obs, s] += lr * q[s]`` for the states ``q = qs[0]`` reaches (mass
+        above ``SUPPORT_CUTOFF``: a smaller update changes no count by more than 1e-12)."""
+        if not isinstance(obs, int | np.integer):
+            raise SpecError("a sparse likelihood learns from an outcome index")
+        q = np.asarray(qs[0], dtype=float)[: self.num_states]
         if lr <= 0:
             raise ValueError(f"learning rate must be positive, got {lr}")
         for s in np.flatnonzero(q > SUPPORT_CUTOFF):
@@ -253,12 +421,12 @@ class SparseLikelihood:
         np.add.at(contrib, (rows, inv), (self.cnt[states] / T[:, None])[valid])
         return bg, outcomes, bg[:, None] + qs @ contrib
 
-    def slot_outcome_index(self, states: np.ndarray, outcomes: np.ndarray) -> np.ndarray:
-        """For each (state, slot), the position of its outcome in ``outcomes`` (-1: free slot)."""
+    def scatter_slots(self, states: np.ndarray, outcomes: np.ndarray, per_slot: np.ndarray) -> np.ndarray:
+        """``out[i, j]``: the value ``per_slot[i, k]`` of the slot of state ``states[i]`` holding
+        outcome ``outcomes[j]`` (0 where that state learned nothing of it); ``outcomes`` sorted."""
         obs = self.obs[np.asarray(states, dtype=np.int64)]
-        pos = np.searchsorted(outcomes, np.maximum(obs, 0))
-        pos = np.minimum(pos, max(outcomes.size - 1, 0))
-        ok = (obs >= 0) & (outcomes.size > 0)
-        if outcomes.size:
-            ok &= outcomes[pos] == obs
-        return np.where(ok, pos, -1)
+        out = np.zeros((obs.shape[0], outcomes.size))
+        rows, k = np.nonzero(obs >= 0)
+        if rows.size:
+            out[rows, np.searchsorted(outcomes, obs[rows, k])] = per_slot[rows, k]
+        return out

@@ -5,8 +5,10 @@ arrays are reallocated only when a capacity doubles, so compiled (jitted) functi
 shapes are reused and the number of reallocations after ``n`` growth steps is about
 ``log2(n)`` (counted in :attr:`Model.compile_count`).
 
-The model holds data only; the maths lives in pure functions (``cogmap.inference``,
-``cogmap.planning``) that take these arrays.
+Each likelihood and transition factor is one object that owns its Dirichlet counts and offers
+the same operations whether dense or sparse (``likelihood.py``, ``transitions.py``); the model
+holds them, the live sizes and the poses. The maths lives in pure functions
+(``cogmap.inference``, ``cogmap.planning``) that take these objects.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .capacity import pad_axis
 from .likelihood import SparseLikelihood
 from .spatial import PoseIndex
 from .spec import Factor, InductiveSpec, Modality, SpecError
@@ -47,13 +50,11 @@ class Model:
 
     factors: tuple[Factor, ...]
     modalities: tuple[Modality, ...]
-    A: list  # np.ndarray (obs_cap, *state_caps) or SparseLikelihood (counts inside, pA[m] None)
+    A: list  # DenseLikelihood or SparseLikelihood (each holds its own counts)
     A_deps: tuple[tuple[int, ...], ...]
-    B: list  # np.ndarray (cap, cap, u) or SparseTransitions
+    B: list  # DenseTransitions or SparseTransitions (each holds its own counts)
     C: list[np.ndarray]
     D: list[np.ndarray]
-    pA: list[np.ndarray | None]
-    pB: list[np.ndarray | None]
     C_states: list[np.ndarray]
     num_states: list[int]
     num_obs: list[int]
@@ -121,50 +122,30 @@ class Model:
 
     def has_counts_A(self, m: int) -> bool:
         """Whether modality ``m`` carries Dirichlet counts (learnable)."""
-        return self.is_sparse_A(m) or self.pA[m] is not None
+        return self.A[m].has_counts
 
     def A_row(self, m: int, o: int) -> np.ndarray:
         """``A[m][o]`` over the live states (the evidence of outcome ``o``)."""
-        if self.is_sparse_A(m):
-            return self.A[m].row(o)
-        idx = (o,) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        return self.A[m][idx]
+        return self.A[m].row(o)
 
     def pA_row(self, m: int, o: int) -> np.ndarray:
         """Counts ``pA[m][o]`` over the live states."""
-        if self.is_sparse_A(m):
-            return self.A[m].counts_row(o)
-        if self.pA[m] is None:
-            raise SpecError(f"modality '{self.modalities[m].name}' has no pA counts")
-        idx = (o,) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        return self.pA[m][idx]
+        return self.A[m].counts_row(o)
 
     # -- live views (copies trimmed to live sizes: references, export, tests) ---------------
     def live_A(self, m: int) -> np.ndarray:
-        if self.is_sparse_A(m):
-            return self.A[m].to_dense()
-        idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        return self.A[m][idx]
+        return self.A[m].to_dense()
 
     def live_pA(self, m: int) -> np.ndarray | None:
-        if self.is_sparse_A(m):
-            return self.A[m].counts_dense()
-        if self.pA[m] is None:
-            return None
-        idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        return self.pA[m][idx]
+        return self.A[m].counts_dense()
 
     def live_B(self, f: int) -> np.ndarray:
-        n = self.num_states[f]
-        if self.is_sparse(f):
-            return self.B[f].to_dense(n)
-        return self.B[f][:n, :n]
+        return self.B[f].to_dense(self.num_states[f])
 
     def live_pB(self, f: int) -> np.ndarray | None:
-        n = self.num_states[f]
-        if self.is_sparse(f):
-            return None if self.B[f].counts is None else self.B[f].counts_dense(n)
-        return None if self.pB[f] is None else self.pB[f][:n, :n]
+        """Dense transition counts of the live states (None without counts)."""
+        B = self.B[f]
+        return None if B.counts is None else B.counts_dense(self.num_states[f])
 
     def live_C(self, m: int) -> np.ndarray:
         return self.C[m][: self.num_obs[m]]
@@ -184,12 +165,8 @@ class Model:
         return pm.index
 
     def predict(self, f: int, q: np.ndarray, u: int) -> np.ndarray:
-        """One-step prediction of factor ``f`` under control ``u`` (dense or sparse)."""
-        B = self.B[f]
-        if isinstance(B, SparseTransitions):
-            return B.predict(q, u)
-        n = q.shape[0]
-        return B[:n, :n, u] @ q
+        """One-step prediction of factor ``f`` under control ``u``."""
+        return self.B[f].predict(q, u)
 
     # -- growth ----------------------------------------------------------------------------
     def add_state(self, factor: str | int = 0, pose=None, obs_count: float | None = None) -> int:
@@ -209,36 +186,11 @@ class Model:
         if s == self.state_capacity(f):
             self._grow_state_capacity(f, 2 * max(1, s))
         self.num_states[f] = s + 1
+        count = self.prior_count if obs_count is None else obs_count
         for m, deps in enumerate(self.A_deps):
-            if f not in deps:
-                continue
-            n_o = self.num_obs[m]
-            if self.is_sparse_A(m):
-                self.A[m].add_state((self.prior_count if obs_count is None else obs_count) * n_o)
-                continue
-            axis = 1 + deps.index(f)
-            col = [slice(None)] * self.A[m].ndim
-            col[axis] = s
-            col = tuple(col)
-            self.A[m][col] = 0.0
-            self.A[m][col][:n_o] = 1.0 / max(1, n_o)
-            if self.pA[m] is not None:
-                self.pA[m][col] = 0.0
-                self.pA[m][col][:n_o] = self.prior_count if obs_count is None else obs_count
-        B = self.B[f]
-        if isinstance(B, SparseTransitions):
-            B.succ[s] = s
-            B.prob[s] = 0.0
-            B.prob[s, :, 0] = 1.0
-            if B.counts is not None:
-                B.counts[s] = 0.0
-                B.counts[s, :, 0] = self.prior_count
-        else:
-            B[:, s, :] = 0.0
-            B[s, s, :] = 1.0
-            if self.pB[f] is not None:
-                self.pB[f][:, s, :] = 0.0
-                self.pB[f][s, s, :] = self.prior_count
+            if f in deps:
+                self.A[m].add_state(deps.index(f), count)
+        self.B[f].add_state(s, self.prior_count)
         self.C_states[f][s] = 0.0
         if self.pose is not None and self.pose.factor == f:
             if pose is None:
@@ -260,73 +212,27 @@ class Model:
         if not self.modalities[m].growable:
             raise SpecError(f"modality '{self.modalities[m].name}' is not growable")
         o = self.num_obs[m]
-        if self.is_sparse_A(m):
-            if count is not None:
-                raise SpecError(f"modality '{self.modalities[m].name}' is sparse: its columns keep their prior "
-                                "mass, spread over the outcomes; add_observation takes no count")
-            if o == self.obs_capacity(m):
-                self._grow_obs_capacity(m, 2 * max(1, o))
-            self.A[m].add_observation()
-            self.num_obs[m] = o + 1
-            self.C[m][o] = 0.0
-            return o
         if o == self.obs_capacity(m):
             self._grow_obs_capacity(m, 2 * max(1, o))
+        self.A[m].add_observation(self.prior_count if count is None and not self.is_sparse_A(m) else count)
         self.num_obs[m] = o + 1
-        live = tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        self.A[m][(o,) + live] = 0.0
-        if self.pA[m] is not None:
-            self.pA[m][(o,) + live] = self.prior_count if count is None else count
-            counts = self.pA[m][(slice(0, o + 1),) + live]
-            self.A[m][(slice(0, o + 1),) + live] = counts / counts.sum(axis=0, keepdims=True)
         self.C[m][o] = 0.0
         return o
 
     def _grow_state_capacity(self, f: int, cap: int) -> None:
-        old = self.state_capacity(f)
         self.compile_count += 1
         for m, deps in enumerate(self.A_deps):
-            if f not in deps or self.is_sparse_A(m):
-                continue  # a sparse likelihood reserves its own room
-            axis = 1 + deps.index(f)
-            self.A[m] = _pad_axis(self.A[m], axis, cap)
-            if self.pA[m] is not None:
-                self.pA[m] = _pad_axis(self.pA[m], axis, cap)
-        B = self.B[f]
-        if isinstance(B, SparseTransitions):
-            B.grow(cap)
-        else:
-            newB = np.zeros((cap, cap, B.shape[2]))
-            newB[:old, :old] = B
-            newB[np.arange(old, cap), np.arange(old, cap), :] = 1.0
-            self.B[f] = newB
-            if self.pB[f] is not None:
-                newp = np.zeros((cap, cap, B.shape[2]))
-                newp[:old, :old] = self.pB[f]
-                self.pB[f] = newp
-        self.D[f] = _pad_axis(self.D[f], 0, cap)
-        self.C_states[f] = _pad_axis(self.C_states[f], 0, cap)
+            if f in deps:
+                self.A[m].grow_states(deps.index(f), cap)
+        self.B[f].grow(cap)
+        self.D[f] = pad_axis(self.D[f], 0, cap)
+        self.C_states[f] = pad_axis(self.C_states[f], 0, cap)
         if self.pose is not None and self.pose.factor == f:
-            self.pose.poses = _pad_axis(self.pose.poses, 0, cap)
+            self.pose.poses = pad_axis(self.pose.poses, 0, cap)
             if self.pose.index is not None:
                 self.pose.index.poses = self.pose.poses
 
     def _grow_obs_capacity(self, m: int, cap: int) -> None:
         self.compile_count += 1
-        self.C[m] = _pad_axis(self.C[m], 0, cap)
-        if self.is_sparse_A(m):
-            return
-        self.A[m] = _pad_axis(self.A[m], 0, cap)
-        if self.pA[m] is not None:
-            self.pA[m] = _pad_axis(self.pA[m], 0, cap)
-
-
-def _pad_axis(x: np.ndarray, axis: int, size: int) -> np.ndarray:
-    """Zero-pad ``x`` along ``axis`` up to ``size``."""
-    shape = list(x.shape)
-    shape[axis] = size
-    out = np.zeros(shape, dtype=x.dtype)
-    idx = [slice(None)] * x.ndim
-    idx[axis] = slice(0, x.shape[axis])
-    out[tuple(idx)] = x
-    return out
+        self.C[m] = pad_axis(self.C[m], 0, cap)
+        self.A[m].grow_obs(cap)

@@ -1,14 +1,103 @@
-"""Sparse transition storage for topological maps.
+"""Transition factors that own their Dirichlet counts: dense and sparse, same operations.
 
-``succ[s, u, k]`` is the k-th possible successor of state ``s`` under control ``u`` and
-``prob[s, u, k]`` its probability; unused slots point at ``s`` with probability 0. Each node of a
-topological map has a handful of neighbours, so predictions cost O(states x slots), not
-O(states^2), and 10,000 states with 13 controls take a few MB.
+Both types hold ``B`` for one factor at a reserved capacity, with optional counts, and offer
+the same operations: ``predict`` (one step of a belief), ``column``, ``to_dense`` /
+``counts_dense`` (live part), ``edges`` (believed-possible moves), ``add_state`` (a new state
+that stays put), ``grow`` (a larger capacity) and ``learn`` (a Dirichlet update of one column,
+renormalised).
+
+:class:`DenseTransitions` stores ``prob[next, current, control]`` (pymdp layout).
+:class:`SparseTransitions` stores padded successor lists: ``succ[s, u, k]`` is the k-th
+possible successor of state ``s`` under control ``u`` and ``prob[s, u, k]`` its probability;
+unused slots point at ``s`` with probability 0. Each node of a topological map has a handful of
+neighbours, so predictions cost O(states x slots), not O(states^2), and 10,000 states with 13
+controls take a few MB.
 """
 
 from __future__ import annotations
 
 import numpy as np
+
+
+class DenseTransitions:
+    """Dense ``prob[next, current, control]`` at capacity, with optional counts of the same shape."""
+
+    def __init__(self, prob: np.ndarray, counts: np.ndarray | None = None):
+        self.prob = np.asarray(prob, dtype=float)
+        self.counts = None if counts is None else np.asarray(counts, dtype=float)
+
+    @property
+    def capacity(self) -> int:
+        return self.prob.shape[0]
+
+    @property
+    def num_controls(self) -> int:
+        return self.prob.shape[2]
+
+    def predict(self, q: np.ndarray, u: int) -> np.ndarray:
+        n = q.shape[0]
+        return self.prob[:n, :n, u] @ q
+
+    def column(self, s: int, u: int, n: int) -> np.ndarray:
+        return self.prob[:n, s, u].copy()
+
+    def to_dense(self, n: int | None = None) -> np.ndarray:
+        """The live ``(n, n, u)`` block (a view)."""
+        n = self.capacity if n is None else n
+        return self.prob[:n, :n]
+
+    def counts_dense(self, n: int | None = None) -> np.ndarray | None:
+        n = self.capacity if n is None else n
+        return None if self.counts is None else self.counts[:n, :n]
+
+    def edges(self, threshold: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(src, dst)`` pairs with ``B[dst, src, u] > threshold`` for some control (no self loops)."""
+        adj = (self.prob[:n, :n] > threshold).any(axis=2)
+        np.fill_diagonal(adj, False)
+        dst, src = np.nonzero(adj)
+        return src, dst
+
+    def control_edges(self, u: int, n: int, min_prob: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(src, dst, prob)`` of the moves under control ``u`` with probability >= ``min_prob``
+        (no self loops)."""
+        dst, src = np.nonzero(self.prob[:n, :n, u] >= min_prob)
+        keep = src != dst
+        return src[keep], dst[keep], self.prob[dst[keep], src[keep], u]
+
+    def add_state(self, s: int, prior_count: float) -> None:
+        """State ``s`` stays put under every control (counts ``prior_count`` on staying)."""
+        self.prob[:, s, :] = 0.0
+        self.prob[s, s, :] = 1.0
+        if self.counts is not None:
+            self.counts[:, s, :] = 0.0
+            self.counts[s, s, :] = prior_count
+
+    def grow(self, capacity: int) -> None:
+        old, u = self.capacity, self.num_controls
+        prob = np.zeros((capacity, capacity, u))
+        prob[:old, :old] = self.prob
+        prob[np.arange(old, capacity), np.arange(old, capacity), :] = 1.0
+        self.prob = prob
+        if self.counts is not None:
+            counts = np.zeros((capacity, capacity, u))
+            counts[:old, :old] = self.counts
+            self.counts = counts
+
+    def learn(self, s: int, u: int, target: int, lr: float, n: int, floor: float, max_concentration: float) -> None:
+        """``counts[target, s, u] += lr`` (floored); a negative ``lr`` moves the mass to staying;
+        the column is capped at ``max_concentration`` and renormalised (live states ``n``)."""
+        c = self.counts
+        if lr < 0 and c[target, s, u] <= 0:
+            return  # nothing believed to remove
+        c[target, s, u] = max(c[target, s, u] + lr, floor)
+        if lr < 0:
+            c[s, s, u] += -lr
+        col = c[:n, s, u]
+        total = col.sum()
+        if total > max_concentration:
+            col *= max_concentration / total
+            total = max_concentration
+        self.prob[:n, s, u] = col / total
 
 
 class SparseTransitions:
@@ -92,6 +181,43 @@ class SparseTransitions:
         out = np.zeros(n)
         np.add.at(out, self.succ[s, u], self.prob[s, u])
         return out
+
+    def edges(self, threshold: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+        """``(src, dst)`` pairs with probability above ``threshold`` (no self loops)."""
+        s = self.succ[:n]
+        ok = (self.prob[:n] > threshold) & (s != np.arange(n)[:, None, None])
+        src = np.broadcast_to(np.arange(n)[:, None, None], s.shape)[ok]
+        return src, s[ok]
+
+    def control_edges(self, u: int, n: int, min_prob: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """As :meth:`DenseTransitions.control_edges`."""
+        src = np.repeat(np.arange(n), self.slots)
+        dst, prob = self.succ[:n, u].ravel(), self.prob[:n, u].ravel()
+        keep = (prob >= min_prob) & (src != dst)
+        return src[keep], dst[keep], prob[keep]
+
+    def add_state(self, s: int, prior_count: float) -> None:
+        """State ``s`` stays put under every control (counts ``prior_count`` on staying)."""
+        self.succ[s] = s
+        self.prob[s] = 0.0
+        self.prob[s, :, 0] = 1.0
+        if self.counts is not None:
+            self.counts[s] = 0.0
+            self.counts[s, :, 0] = prior_count
+
+    def learn(self, s: int, u: int, target: int, lr: float, n: int, floor: float, max_concentration: float) -> None:
+        """As :meth:`DenseTransitions.learn`, on the slot of ``target`` (claimed if new)."""
+        if lr < 0 and self.slot_of(s, u, target, create=False) < 0:
+            return  # nothing believed to remove
+        k = self.slot_of(s, u, target)
+        self.counts[s, u, k] = max(self.counts[s, u, k] + lr, floor)
+        if lr < 0:
+            k_stay = self.slot_of(s, u, s)  # may widen the arrays: index them afterwards
+            self.counts[s, u, k_stay] += -lr
+        total = self.counts[s, u].sum()
+        if total > max_concentration:
+            self.counts[s, u] *= max_concentration / total
+        self.renormalise_column(s, u)
 
     # -- growth and learning -------------------------------------------------------------
     def grow(self, capacity: int) -> None:

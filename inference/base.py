@@ -172,7 +172,6 @@ def modality_evidence(model, m: int, value, t: int = 0) -> Evidence | None:
     name = model.modalities[m].name
     n_o = model.num_obs[m]
     deps = model.A_deps[m]
-    live = tuple(slice(0, model.num_states[f]) for f in deps)
     if isinstance(value, bool | np.bool_):
         raise InferenceError(f"observations[{t}] for modality '{name}': got a bool, expected an index")
     if isinstance(value, int | np.integer):
@@ -184,10 +183,7 @@ def modality_evidence(model, m: int, value, t: int = 0) -> Evidence | None:
             )
         return Evidence(deps, model.A_row(m, o), 0.0, name)
     p = _check_distribution(value, n_o, model.obs_capacity(m), f"observations[{t}] for modality '{name}'")
-    if model.is_sparse_A(m):
-        return Evidence(deps, model.A[m].expected_row(p[:n_o]), 0.0, name)
-    lik = np.tensordot(p, model.A[m][(slice(0, n_o),) + live], axes=(0, 0))
-    return Evidence(deps, lik, 0.0, name)
+    return Evidence(deps, model.A[m].expected_row(p[:n_o]), 0.0, name)
 
 
 def pose_evidence(model, pose, t: int = 0) -> Evidence | None:
@@ -278,11 +274,11 @@ def dense_transition(model, f: int, u: int) -> np.ndarray:
     """Live dense ``B[f][:, :, u]`` (``(next, current)``) for dense or sparse storage."""
     n = model.num_states[f]
     B = model.B[f]
-    if model.is_sparse(f):
+    if model.is_sparse(f):  # only control u, not the whole dense copy
         out = np.zeros((n, n))
         np.add.at(out, (B.succ[:n, u].ravel(), np.repeat(np.arange(n), B.slots)), B.prob[:n, u].ravel())
         return out
-    return B[:n, :n, u]
+    return B.to_dense(n)[:, :, u]
 
 
 def marginal_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs, f: int) -> np.ndarray:

@@ -19,9 +19,9 @@ from enum import Enum
 
 import numpy as np
 
+from cogmap.genmodel.dirichlet import normalise_counts, update_pA  # noqa: F401 - the pure updates, re-exported
 from cogmap.genmodel.model import Model
 from cogmap.genmodel.spec import SpecError
-from cogmap.genmodel.transitions import SparseTransitions
 
 
 class Event(Enum):
@@ -51,19 +51,6 @@ TABLE7 = LearningRates()
 
 
 # -- pure updates ------------------------------------------------------------------------------
-def update_pA(pA: np.ndarray, obs, qs: list[np.ndarray], lr: float = 1.0, floor: float = 1e-3) -> np.ndarray:
-    """``pA + lr * o (x) q(s_deps)`` for one modality; ``obs`` is an index or a distribution."""
-    pA = np.asarray(pA, dtype=float)
-    o = _as_distribution(obs, pA.shape[0])
-    outer = o
-    for q in qs:
-        outer = np.multiply.outer(outer, np.asarray(q, dtype=float))
-    if outer.shape != pA.shape:
-        raise SpecError(f"update_pA: outer product shape {outer.shape} does not match pA {pA.shape}")
-    new = pA + lr * outer
-    return np.where(outer > 0, np.maximum(new, floor), new)
-
-
 def update_pB(pB: np.ndarray, q_next, q_prev, control: int, lr: float = 1.0, floor: float = 1e-3) -> np.ndarray:
     """``pB[:, :, u] + lr * q(s_t) (x) q(s_t-1)`` with counts floored at ``floor`` (Eq. 8)."""
     pB = np.array(pB, dtype=float)
@@ -74,26 +61,6 @@ def update_pB(pB: np.ndarray, q_next, q_prev, control: int, lr: float = 1.0, flo
     col = pB[:, :, control] + lr * np.outer(q_next, q_prev)
     pB[:, :, control] = np.where(touched, np.maximum(col, floor), col)
     return pB
-
-
-def normalise_counts(p: np.ndarray) -> np.ndarray:
-    """Expected parameters of Dirichlet counts (columns over the first axis)."""
-    s = p.sum(axis=0, keepdims=True)
-    return np.where(s > 0, p / np.where(s > 0, s, 1.0), 1.0 / p.shape[0])
-
-
-def _as_distribution(obs, n: int) -> np.ndarray:
-    if np.ndim(obs) == 0:
-        o = int(obs)
-        if not 0 <= o < n:
-            raise SpecError(f"observation {o} out of range [0, {n})")
-        v = np.zeros(n)
-        v[o] = 1.0
-        return v
-    v = np.asarray(obs, dtype=float)
-    if v.shape != (n,):
-        raise SpecError(f"observation distribution has shape {v.shape}, expected ({n},)")
-    return v
 
 
 # -- in-place updates on a model ---------------------------------------------------------------
@@ -127,41 +94,9 @@ def learn_transition(
         if u == stay:
             continue
         B = model.B[f]
-        if isinstance(B, SparseTransitions):
-            _learn_sparse(B, a, u, b, lr, rates)
-        else:
-            _learn_dense(model, f, a, u, b, lr, rates)
-
-
-def _learn_sparse(B: SparseTransitions, s: int, u: int, target: int, lr: float, rates: LearningRates) -> None:
-    if B.counts is None:
-        raise SpecError("learn_transition: transitions have no Dirichlet counts")
-    if lr < 0 and B.slot_of(s, u, target, create=False) < 0:
-        return  # nothing believed to remove
-    k = B.slot_of(s, u, target)
-    B.counts[s, u, k] = max(B.counts[s, u, k] + lr, rates.floor)
-    if lr < 0:
-        B.counts[s, u, B.slot_of(s, u, s)] += -lr
-    total = B.counts[s, u].sum()
-    if total > rates.max_concentration:
-        B.counts[s, u] *= rates.max_concentration / total
-    B.renormalise_column(s, u)
-
-
-def _learn_dense(model: Model, f: int, s: int, u: int, target: int, lr: float, rates: LearningRates) -> None:
-    pB = model.pB[f]
-    if pB is None:
-        raise SpecError(f"learn_transition: factor '{model.factors[f].name}' has no pB counts")
-    n = model.num_states[f]
-    pB[target, s, u] = max(pB[target, s, u] + lr, rates.floor)
-    if lr < 0:
-        pB[s, s, u] += -lr
-    col = pB[:n, s, u]
-    total = col.sum()
-    if total > rates.max_concentration:
-        col *= rates.max_concentration / total
-        total = rates.max_concentration
-    model.B[f][:n, s, u] = col / total
+        if B.counts is None:
+            raise SpecError(f"learn_transition: factor '{model.factors[f].name}' has no pB counts")
+        B.learn(a, u, b, lr, n, rates.floor, rates.max_concentration)
 
 
 def learn_observation(model: Model, modality: int, obs: int, qs: list[np.ndarray], lr: float = 1.0) -> None:
@@ -170,22 +105,4 @@ def learn_observation(model: Model, modality: int, obs: int, qs: list[np.ndarray
     if not model.has_counts_A(m):
         raise SpecError(f"learn_observation: modality '{model.modalities[m].name}' has no pA counts")
     deps = model.A_deps[m]
-    if model.is_sparse_A(m):
-        if not isinstance(obs, int | np.integer):
-            raise SpecError("learn_observation: a sparse likelihood learns from an outcome index")
-        model.A[m].learn(int(obs), np.asarray(qs[deps[0]])[: model.num_states[deps[0]]], lr)
-        return
-    deps_q = [np.asarray(qs[f])[: model.num_states[f]] for f in deps]
-    n_o = model.num_obs[m]
-    if len(deps) == 1:  # touch only the columns the belief reaches: O(outcomes x support)
-        cols = np.flatnonzero(deps_q[0] > 0)
-        o = _as_distribution(obs, n_o)
-        block = model.pA[m][:n_o, cols] + lr * np.outer(o, deps_q[0][cols])
-        block = np.where(o[:, None] > 0, np.maximum(block, 1e-3), block)
-        model.pA[m][:n_o, cols] = block
-        model.A[m][:n_o, cols] = normalise_counts(block)
-        return
-    live = (slice(0, n_o),) + tuple(slice(0, model.num_states[f]) for f in deps)
-    new = update_pA(model.pA[m][live], obs, deps_q, lr)
-    model.pA[m][live] = new
-    model.A[m][live] = normalise_counts(new)
+    model.A[m].learn(obs, [np.asarray(qs[f], dtype=float)[: model.num_states[f]] for f in deps], lr)

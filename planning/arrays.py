@@ -16,6 +16,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cogmap.genmodel.likelihood import DenseLikelihood, SparseLikelihood
+from cogmap.genmodel.transitions import DenseTransitions, SparseTransitions
+
 from . import inductive as ind
 from .efe import EPS, entropy, novelty_weights
 
@@ -24,14 +27,14 @@ from .efe import EPS, entropy, novelty_weights
 class PlanningArrays:
     A: list  # A[m]: (obs_cap, *state_caps[deps]); live part [:num_obs[m], :num_states...]
     A_deps: tuple
-    B: list  # dense (cap, cap, u) or an object with succ/prob/counts (sparse, one factor)
+    B: list  # DenseTransitions / SparseTransitions (raw (cap, cap, u) arrays are wrapped, with pB)
     C: list
     num_states: tuple
     num_obs: tuple
     num_controls: tuple
     C_states: list | None = None
-    pA: list | None = None
-    pB: list | None = None  # dense counts; sparse factors keep counts on B[f].counts
+    pA: list | None = None  # counts for raw A arrays only (likelihood objects hold their own)
+    pB: list | None = None  # counts for raw dense B arrays only (transition objects hold their own)
     stay: tuple | None = None
     poses: np.ndarray | None = None
     pose_factor: int = 0
@@ -45,41 +48,42 @@ class PlanningArrays:
     control_factor: int = 0  # factor whose controls the obstacle signal refers to
     view: np.ndarray | None = None  # per state of pose_factor: unseen fraction of its view, in [0, 1]
 
+    def __post_init__(self):
+        likelihoods = [
+            DenseLikelihood(A, None if self.pA is None else self.pA[m], self.num_obs[m],
+                            tuple(self.num_states[f] for f in self.A_deps[m]))
+            if isinstance(A, np.ndarray) else A
+            for m, A in enumerate(self.A)
+        ]
+        object.__setattr__(self, "A", likelihoods)
+        object.__setattr__(self, "pA", None)
+        wrapped = [
+            DenseTransitions(B, None if self.pB is None else self.pB[f]) if isinstance(B, np.ndarray) else B
+            for f, B in enumerate(self.B)
+        ]
+        object.__setattr__(self, "B", wrapped)
+        object.__setattr__(self, "pB", None)
+
     @property
     def num_factors(self) -> int:
         return len(self.B)
 
     def is_sparse(self, f: int) -> bool:
-        return hasattr(self.B[f], "succ")
+        return isinstance(self.B[f], SparseTransitions)
 
     def live_A(self, m: int) -> np.ndarray:
-        if not isinstance(self.A[m], np.ndarray):  # sparse likelihood: densified (small models only)
-            return self.A[m].to_dense()
-        idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        return self.A[m][idx]
+        """Dense live ``A[m]`` (a sparse likelihood is densified: small models only)."""
+        return self.A[m].to_dense()
 
     def live_B(self, f: int) -> np.ndarray:
-        n = self.num_states[f]
-        if self.is_sparse(f):
-            return self.B[f].to_dense(n)
-        return self.B[f][:n, :n]
+        return self.B[f].to_dense(self.num_states[f])
 
     def live_pA(self, m: int):
-        if not isinstance(self.A[m], np.ndarray):
-            return self.A[m].counts_dense()
-        if self.pA is None or self.pA[m] is None:
-            return None
-        idx = (slice(0, self.num_obs[m]),) + tuple(slice(0, self.num_states[f]) for f in self.A_deps[m])
-        return self.pA[m][idx]
+        return self.A[m].counts_dense()
 
     def live_pB(self, f: int):
-        n = self.num_states[f]
-        if self.is_sparse(f):
-            c = self.B[f].counts
-            return None if c is None else self.B[f].counts_dense(n)
-        if self.pB is None or self.pB[f] is None:
-            return None
-        return self.pB[f][:n, :n]
+        B = self.B[f]
+        return None if B.counts is None else B.counts_dense(self.num_states[f])
 
 
 def from_model(
@@ -122,8 +126,6 @@ def from_model(
         num_obs=tuple(model.num_obs),
         num_controls=tuple(model.num_controls),
         C_states=list(model.C_states),
-        pA=list(model.pA),
-        pB=list(model.pB),
         stay=tuple(f.stay for f in model.factors),
         poses=None if pose is None else pose.poses,
         pose_factor=pf,
@@ -150,7 +152,7 @@ def as_arrays(model) -> PlanningArrays:
 
 @dataclass
 class Prepared:
-    """Derived quantities for one decision (dense: full arrays; sparse: per-state caches)."""
+    """Derived quantities for one decision (dense: full arrays; local: per-state caches)."""
 
     arrays: PlanningArrays
     local: bool = False  # single sparse factor, per-state caches
@@ -159,45 +161,26 @@ class Prepared:
     wA: list = field(default_factory=list)  # dense: novelty weights per modality (or None)
     wB: list = field(default_factory=list)  # dense: novelty weights per factor (or None)
     dist: np.ndarray | None = None  # goal distances of goal_factor (None: no goal)
-    _slot: np.ndarray | None = None  # sparse caches: state -> column slot (-1: not computed)
-    _HA_cols: list = field(default_factory=list)
-    _wA_cols: list = field(default_factory=list)
-    _used: int = 0
     need_novelty: bool = True
+    _cache: dict = field(default_factory=dict)  # local path, dense likelihoods: state -> column stats
 
-    # lazily filled column statistics for the sparse (single-factor) path
-    def columns(self, U: np.ndarray) -> tuple[list, list]:
-        """Entropies ``H[A_m[:, s]]`` and novelty columns ``wA_m[:, s]`` for states ``U``."""
-        slots = self._slot[U]
-        new = U[slots < 0]
+    def column_stats(self, m: int, U: np.ndarray):
+        """``(H, w_bg, w_slots)`` of likelihood ``m`` at states ``U`` (see
+        ``SparseLikelihood.column_stats``). A sparse likelihood computes them in O(slots) per
+        state; a dense one in O(outcomes), so they are kept for the rest of the decision."""
+        A = self.arrays.A[m]
+        novelty = self.need_novelty and A.has_counts
+        if isinstance(A, SparseLikelihood):
+            return A.column_stats(U, novelty)
+        cache = self._cache.setdefault(m, {})
+        new = np.array([s for s in np.unique(U).tolist() if s not in cache], dtype=np.int64)
         if new.size:
-            self._ensure_room(new.size)
-            a = self.arrays
-            k = np.arange(self._used, self._used + new.size)
-            for m in range(len(a.A)):
-                if not isinstance(a.A[m], np.ndarray):
-                    continue  # a sparse likelihood computes its own column statistics
-                cols = a.A[m][: a.num_obs[m], new]
-                self._HA_cols[m][k] = entropy(cols, axis=0)
-                if self._wA_cols[m] is not None:
-                    self._wA_cols[m][:, k] = novelty_weights(a.pA[m][: a.num_obs[m], new])
-            self._slot[new] = k
-            self._used += new.size
-            slots = self._slot[U]
-        HA = [h[slots] for h in self._HA_cols]
-        wA = [None if w is None else w[:, slots] for w in self._wA_cols]
-        return HA, wA
-
-    def _ensure_room(self, extra: int) -> None:
-        cap = self._HA_cols[0].shape[0]
-        if self._used + extra <= cap:
-            return
-        new_cap = max(2 * cap, self._used + extra)
-        self._HA_cols = [np.concatenate([h, np.zeros(new_cap - cap)]) for h in self._HA_cols]
-        self._wA_cols = [
-            None if w is None else np.concatenate([w, np.zeros((w.shape[0], new_cap - cap))], axis=1)
-            for w in self._wA_cols
-        ]
+            H, w_bg, w_slots = A.column_stats(new, novelty)
+            for i, s in enumerate(new.tolist()):
+                cache[s] = (H[i], w_bg[i], w_slots[i])
+        rows = [cache[s] for s in U.tolist()]
+        return (np.array([r[0] for r in rows]), np.array([r[1] for r in rows]),
+                np.array([r[2] for r in rows]).reshape(len(rows), -1))
 
 
 def prepare(
@@ -215,18 +198,7 @@ def prepare(
     if local and not (a.num_factors == 1 and a.is_sparse(0)):
         raise ValueError("the local planning path needs a single factor with sparse transitions")
     prep = Prepared(arrays=a, local=local, need_novelty=need_novelty)
-    if local:
-        n = a.num_states[0]
-        prep._slot = np.full(max(n, 1), -1, dtype=np.int64)
-        cap = 64
-        prep._HA_cols = [np.zeros(cap) for _ in a.A]
-        prep._wA_cols = [
-            None
-            if (not need_novelty or a.pA is None or a.pA[m] is None or not isinstance(a.A[m], np.ndarray))
-            else np.zeros((a.num_obs[m], cap))
-            for m in range(len(a.A))
-        ]
-    else:
+    if not local:
         prep.B = [a.live_B(f) for f in range(a.num_factors)]
         for m in range(len(a.A)):
             A_m = a.live_A(m)
@@ -239,10 +211,7 @@ def prepare(
     if need_goal and a.goal_states is not None and len(a.goal_states):
         f = a.goal_factor
         n = a.num_states[f]
-        if a.is_sparse(f):
-            src, dst = ind.edges_sparse(a.B[f].succ, a.B[f].prob, a.inductive_threshold, n)
-        else:
-            src, dst = ind.edges_dense(a.B[f], a.inductive_threshold, n)
+        src, dst = a.B[f].edges(a.inductive_threshold, n)
         prep.dist = ind.goal_distances(src, dst, a.goal_states, n, a.inductive_depth)
     return prep
 

@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 
+from cogmap.genmodel.transitions import DenseTransitions, SparseTransitions
+
 
 def _search(start, goal, neighbours, heuristic):
     """Generic A*: returns ``(path, cost)`` or ``(None, inf)``."""
@@ -50,11 +52,8 @@ def _search(start, goal, neighbours, heuristic):
 
 def sparse_graph_edges(B, poses: np.ndarray, n: int, threshold: float = 0.5) -> dict:
     """Adjacency ``{s: [(t, metric distance), ...]}`` of transitions with probability above
-    ``threshold`` in padded successor lists (``B.succ``, ``B.prob``)."""
-    succ, prob = B.succ[:n], B.prob[:n]
-    ok = (prob > threshold) & (succ != np.arange(n)[:, None, None])
-    src = np.broadcast_to(np.arange(n)[:, None, None], succ.shape)[ok]
-    dst = succ[ok]
+    ``threshold`` in a transition factor (``B.edges``)."""
+    src, dst = B.edges(threshold, n)
     w = np.linalg.norm(poses[src] - poses[dst], axis=1)
     adj: dict = {}
     for s, t, d in zip(src.tolist(), dst.tolist(), w.tolist(), strict=True):
@@ -67,11 +66,11 @@ def sparse_graph_edges(B, poses: np.ndarray, n: int, threshold: float = 0.5) -> 
 def astar_graph(graph, start, goal, poses=None, threshold: float = 0.5, weight: str = "weight"):
     """Shortest path on a cognitive map. ``graph`` is a networkx graph (edge ``weight``
     attribute, else the distance between node ``pose`` attributes / ``poses``) or sparse
-    transitions with ``succ``/``prob`` (then ``poses`` is required). Returns ``(path, cost)``,
+    a transition factor, dense or sparse (then ``poses`` is required). Returns ``(path, cost)``,
     ``(None, inf)`` when unreachable."""
-    if hasattr(graph, "succ") and hasattr(graph, "prob") and not hasattr(graph, "adj"):
+    if isinstance(graph, DenseTransitions | SparseTransitions):
         if poses is None:
-            raise ValueError("astar_graph on sparse transitions needs the stored poses")
+            raise ValueError("astar_graph on a transition factor needs the stored poses")
         P = np.asarray(poses, dtype=float)
         adj = sparse_graph_edges(graph, P, P.shape[0], threshold)
         gx, gy = P[goal]

@@ -60,11 +60,6 @@ def expect(T: np.ndarray, qs: list[np.ndarray], keep_first: bool = False) -> np.
     return np.einsum(_subscripts(len(qs), keep_first), T, *qs, optimize=True)
 
 
-def _sparse(A) -> bool:
-    """A likelihood stored sparsely (``cogmap.genmodel.SparseLikelihood``), not as an array."""
-    return hasattr(A, "mixture")
-
-
 class _Common:
     prep: Prepared
     collision: np.ndarray | None
@@ -238,92 +233,63 @@ class LocalStep(_Common):
         return [np.broadcast_to(self.prior_p, (self.num_candidates, self.prior_idx.size))]
 
     @cached_property
-    def _cols(self):
-        return self.prep.columns(self.U)
-
-    @cached_property
     def _outcomes(self) -> list:
-        """Per modality: the compressed predicted outcomes of a sparse likelihood (see
-        :meth:`SparseLikelihood.mixture`), or None for a dense one."""
-        return [A.mixture(self.U, self.qs[0]) if _sparse(A) else None for A in self._a.A]
+        """Per modality: the predicted outcomes, compressed (``(bg, outcomes, values)``, see
+        ``SparseLikelihood.mixture``; a dense likelihood lists every outcome)."""
+        return [A.mixture(self.U, self.qs[0]) for A in self._a.A]
 
     @cached_property
     def _stats(self) -> list:
-        """Per sparse modality: column entropies and novelty weights of the states in ``U``."""
-        a = self._a
-        return [A.column_stats(self.U, novelty=self.prep.need_novelty) if _sparse(A) else None for A in a.A]
+        """Per modality: column entropies and novelty weights of the states in ``U``."""
+        return [self.prep.column_stats(m, self.U) for m in range(len(self._a.A))]
 
     @cached_property
     def qo(self) -> list:
-        """Predicted outcome distributions (dense over every outcome: small models, tests)."""
-        a = self._a
+        """Predicted outcome distributions, dense over every outcome (small models, tests)."""
         out = []
-        for m, A in enumerate(a.A):
-            if _sparse(A):
-                bg, outcomes, values = self._outcomes[m]
-                full = np.repeat(bg[:, None], a.num_obs[m], axis=1)
-                full[:, outcomes] = values
-                out.append(full)
-            else:
-                out.append(self.qs[0] @ A[: a.num_obs[m], self.U].T)
+        for m, (bg, outcomes, values) in enumerate(self._outcomes):
+            full = np.repeat(bg[:, None], self._a.num_obs[m], axis=1)
+            full[:, outcomes] = values
+            out.append(full)
         return out
 
     @cached_property
     def outcome_entropy(self) -> list:
-        a = self._a
-        out = []
-        for m, A in enumerate(a.A):
-            if _sparse(A):
-                bg, outcomes, values = self._outcomes[m]
-                rest = a.num_obs[m] - outcomes.size
-                out.append(-rest * xlogx(bg) - xlogx(values).sum(axis=1))
-            else:
-                out.append(entropy(self.qo[m], axis=1))
-        return out
+        return [-(self._a.num_obs[m] - outcomes.size) * xlogx(bg) - xlogx(values).sum(axis=1)
+                for m, (bg, outcomes, values) in enumerate(self._outcomes)]
 
     @cached_property
     def outcome_utility(self) -> list:
         a = self._a
         out = []
-        for m, A in enumerate(a.A):
+        for m, (bg, outcomes, values) in enumerate(self._outcomes):
             c = a.C[m][: a.num_obs[m]]
-            if _sparse(A):
-                bg, outcomes, values = self._outcomes[m]
-                out.append(bg * (c.sum() - c[outcomes].sum()) + values @ c[outcomes])
-            else:
-                out.append(self.qo[m] @ c)
+            rest = c.sum() - c[outcomes].sum() if outcomes.size < c.size else 0.0
+            out.append(bg * rest + values @ c[outcomes])
         return out
 
     @cached_property
     def ambiguity(self) -> list:
-        return [self.qs[0] @ (st[0] if st is not None else h) for st, h in zip(self._stats, self._cols[0], strict=True)]
+        return [self.qs[0] @ st[0] for st in self._stats]
 
     @cached_property
     def a_novelty(self) -> list:
-        a = self._a
-        out = []
-        for m, A in enumerate(a.A):
-            if _sparse(A):
-                out.append(self._sparse_a_novelty(m, A) if self.prep.need_novelty else None)
-                continue
-            w = self._cols[1][m]
-            out.append(None if w is None else (self.qo[m] * (self.qs[0] @ w.T)).sum(axis=1))
-        return out
-
-    def _sparse_a_novelty(self, m: int, A) -> np.ndarray:
-        """``sum_o Q(o) E_Q(s)[W(o, s)]`` from the compressed outcomes: every unlearned outcome
-        shares the background weight of each column; learned slots add their difference."""
+        """``sum_o Q(o) E_Q(s)[W(o, s)]`` from the compressed outcomes: every unlisted outcome
+        shares the background weight of each column; listed slots add their difference."""
         qs = self.qs[0]
-        bg, outcomes, values = self._outcomes[m]
-        _, w_bg, w_slots = self._stats[m]
-        wb = qs @ w_bg  # (K,) expected background weight
-        pos = A.slot_outcome_index(self.U, outcomes)
-        diff = np.zeros((self.U.size, outcomes.size))
-        rows, k = np.nonzero(pos >= 0)
-        np.add.at(diff, (rows, pos[rows, k]), (w_slots - w_bg[:, None])[rows, k])
-        w_learned = wb[:, None] + qs @ diff
-        rest = self._a.num_obs[m] - outcomes.size
-        return rest * bg * wb + (values * w_learned).sum(axis=1)
+        out = []
+        for m, A in enumerate(self._a.A):
+            if not (self.prep.need_novelty and A.has_counts):
+                out.append(None)
+                continue
+            bg, outcomes, values = self._outcomes[m]
+            _, w_bg, w_slots = self._stats[m]
+            wb = qs @ w_bg  # (K,) expected background weight
+            diff = A.scatter_slots(self.U, outcomes, w_slots - w_bg[:, None])  # (U, listed outcomes)
+            w_listed = wb[:, None] + qs @ diff
+            rest = self._a.num_obs[m] - outcomes.size
+            out.append(rest * bg * wb + (values * w_listed).sum(axis=1))
+        return out
 
     @cached_property
     def b_novelty(self) -> list:

@@ -3,7 +3,8 @@ states over transitions believed possible (probability above a threshold), up to
 
 ``goal_distances`` returns, per state, the number of believed-possible steps to the nearest
 preferred state, or ``UNREACHABLE`` when that is beyond the depth (or there is no goal). It
-works on edge lists, so sparse transitions with thousands of states cost O(edges x depth).
+works on edge lists (``B.edges(threshold, n)`` of a transition factor), so sparse transitions
+with thousands of states cost O(edges x depth).
 ``reachability_matrix`` gives the same information in the layout of pymdp's
 ``generate_I_matrix`` (row ``i``: states that can reach a goal within ``i`` steps).
 """
@@ -13,23 +14,6 @@ from __future__ import annotations
 import numpy as np
 
 UNREACHABLE = np.iinfo(np.int64).max // 2
-
-
-def edges_dense(B: np.ndarray, threshold: float, n: int | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """``(src, dst)`` pairs with ``B[dst, src, u] > threshold`` for some control (no self loops)."""
-    n = B.shape[0] if n is None else n
-    adj = (B[:n, :n] > threshold).any(axis=2)
-    np.fill_diagonal(adj, False)
-    dst, src = np.nonzero(adj)
-    return src, dst
-
-
-def edges_sparse(succ: np.ndarray, prob: np.ndarray, threshold: float, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """``(src, dst)`` pairs from padded successor lists (``succ[s, u, k]``, ``prob[s, u, k]``)."""
-    s = succ[:n]
-    ok = (prob[:n] > threshold) & (s != np.arange(n)[:, None, None])
-    src = np.broadcast_to(np.arange(n)[:, None, None], s.shape)[ok]
-    return src, s[ok]
 
 
 def goal_distances(

@@ -19,7 +19,7 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
     Sources of believed transitions that the latest scan shows blocked count as candidates too
     (worth ``view_min_area``). Empty when none is reachable within the inductive depth."""
     cfg, B, n = agent.cfg, agent.model.B[0], agent.num_states
-    src, dst = ind.edges_sparse(B.succ, B.prob, cfg.inductive_threshold, n)
+    src, dst = B.edges(cfg.inductive_threshold, n)
     doubt = agent.views.doubtful(agent.poses, src, dst, state)
     if doubt.size:  # a believed transition crosses a newly sensed obstacle: its source has information
         states = np.concatenate([states, doubt])

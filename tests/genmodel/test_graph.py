@@ -23,7 +23,7 @@ def chain_model(sparse):
     )
     model = compile(spec)
     if sparse:
-        model.B[0] = SparseTransitions.from_dense(model.B[0])
+        model.B[0] = SparseTransitions.from_dense(model.B[0].prob)
     return model
 
 

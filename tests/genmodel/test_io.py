@@ -35,8 +35,7 @@ def grown_model():
 
 def sparse_model():
     model = grown_model()
-    model.B[0] = SparseTransitions.from_dense(model.B[0], counts=model.pB[0])
-    model.pB[0] = None
+    model.B[0] = SparseTransitions.from_dense(model.B[0].prob, counts=model.B[0].counts)
     return model
 
 

@@ -49,7 +49,7 @@ def random_history(seed, steps=120):
         r = rng.random()
         if r < 0.25:
             c = float(rng.uniform(0.05, 2.0))
-            L.add_state(c)
+            L.add_state(0, c / L.num_obs)
             ref.add_state(c)
         elif r < 0.45:
             L.add_observation()
@@ -60,7 +60,7 @@ def random_history(seed, steps=120):
             q[q < 1e-3] = 0.0  # sparse beliefs, as the agent's
             q /= q.sum()
             lr = float(rng.uniform(0.5, 4.0))
-            L.learn(o, q, lr)
+            L.learn(o, [q], lr)
             ref.learned[o] += lr * q
     return L, ref, rng
 
@@ -102,9 +102,9 @@ def test_column_statistics_match_dense_entropy_and_novelty(seed):
 def test_growth_reallocates_logarithmically_and_keeps_learned_counts():
     L = SparseLikelihood(1, 1, capacity=1)
     L.prior[0] = 1.0
-    L.learn(0, np.array([1.0]), 3.0)
+    L.learn(0, [np.array([1.0])], 3.0)
     for _ in range(1000):
-        L.add_state(1.0)
+        L.add_state(0, 1.0 / L.num_obs)
         L.add_observation()
     assert L.reallocations <= int(np.ceil(np.log2(1001)))
     assert L.counts_row(0)[0] == pytest.approx(3.0 + 1.0 / 1001)
@@ -123,12 +123,12 @@ def _sparse_arrays(seed):
     n = base.num_states[0]
     L = SparseLikelihood(12, 0, capacity=n)
     for _ in range(n):
-        L.add_state(float(rng.uniform(0.1, 1.0)))
+        L.add_state(0, float(rng.uniform(0.1, 1.0)) / L.num_obs)
     for _ in range(40):
         q = np.zeros(n)
         idx = rng.choice(n, size=3, replace=False)
         q[idx] = rng.dirichlet(np.ones(3))
-        L.learn(int(rng.integers(12)), q, float(rng.uniform(1, 5)))
+        L.learn(int(rng.integers(12)), [q], float(rng.uniform(1, 5)))
     C = [rng.normal(size=12)]
     sparse = PlanningArrays(**{**base.__dict__, "A": [L], "pA": [None], "C": C})
     dense = PlanningArrays(**{**base.__dict__, "A": [L.to_dense()], "pA": [L.counts_dense()], "C": C})

@@ -25,9 +25,9 @@ def small_spec(**overrides):
 
 def test_valid_spec_compiles_to_pymdp_layout():
     model = compile(small_spec())
-    assert model.A[0].shape == (4, 3, 2)
+    assert model.A[0].prob.shape == (4, 3, 2)
     assert model.A_deps == ((0, 1), (1,))
-    assert model.B[0].shape == (3, 3, 2)
+    assert model.B[0].prob.shape == (3, 3, 2)
     np.testing.assert_allclose(model.D[0], np.full(3, 1 / 3))
     np.testing.assert_allclose(model.C[0], [0.0, 1.0, 0.0, -1.0])
     assert model.factor_names == ("loc", "ctx")

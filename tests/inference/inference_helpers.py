@@ -59,11 +59,11 @@ def _weighted_paths(model, prior, obs, actions):
         for t in range(T):
             if t > 0:
                 p *= np.prod(
-                    [model.B[f][path[t][f], path[t - 1][f], actions[t - 1][f]] for f in range(F)]
+                    [model.live_B(f)[path[t][f], path[t - 1][f], actions[t - 1][f]] for f in range(F)]
                 )
             for m, o in enumerate(obs[t]):
                 if o is not None:
-                    p *= model.A[m][(o,) + tuple(path[t][f] for f in model.A_deps[m])]
+                    p *= model.live_A(m)[(o,) + tuple(path[t][f] for f in model.A_deps[m])]
         yield path, p
 
 

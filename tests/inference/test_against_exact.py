@@ -238,7 +238,7 @@ def test_window_option(name):
 @pytest.mark.parametrize("name", ["exact", "filter"])
 def test_underflow_falls_back_to_log_space(name):
     m = random_model(3, sizes=(3,), modalities=((0,),), obs_sizes=(3,))
-    m.A[0][:, :3] = np.array([[0.0, 1e-30, 0.0], [1.0, 1.0 - 1e-30, 0.0], [0.0, 0.0, 1.0]])
+    m.A[0].prob[:, :3] = np.array([[0.0, 1e-30, 0.0], [1.0, 1.0 - 1e-30, 0.0], [0.0, 0.0, 1.0]])
     D = np.array([1.0 - 1e-300, 1e-300, 0.0])
     # p(o=0) = 1e-330 underflows in double precision but is fine in log space
     q, info = inference.get(name)(m, [D], [[0]])

@@ -136,6 +136,6 @@ def test_filter_refuses_multi_factor():
 
 def test_zero_probability_observation_reported():
     m = random_model(3, sizes=(2,), modalities=((0,),), obs_sizes=(2,))
-    m.A[0][:, :] = np.array([[1.0, 1.0], [0.0, 0.0]])
+    m.A[0].prob[:, :] = np.array([[1.0, 1.0], [0.0, 0.0]])
     with pytest.raises(InferenceError, match="zero probability"):
         inference.exact(m, [m.live_D(0)], [[1]])

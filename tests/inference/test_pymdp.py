@@ -84,7 +84,7 @@ def test_to_pymdp_sparse_and_counts():
     from inference_helpers import pose_model
 
     m = pose_model(10, 0)
-    m.pA[0] = np.where(m.A[0] > 0, 1.0, 0.0) + m.A[0]
+    m.A[0].counts = np.where(m.A[0].prob > 0, 1.0, 0.0) + m.A[0].prob
     agent = inference.to_pymdp(m)
     np.testing.assert_allclose(np.asarray(agent.B[0])[0], m.live_B(0), atol=1e-12)
     assert agent.pA is not None

@@ -46,8 +46,7 @@ def nav_model(sparse):
                      A={"o": np.full((2, n), 0.5)}, B={"s": B}, pA={"o": np.ones((2, n))}, pB={"s": B.copy()})
     model = compile(spec)
     if sparse:
-        model.B[0] = SparseTransitions.from_dense(model.B[0], counts=model.pB[0])
-        model.pB[0] = None
+        model.B[0] = SparseTransitions.from_dense(model.B[0].prob, counts=model.B[0].counts)
     return model
 
 

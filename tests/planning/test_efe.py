@@ -159,7 +159,7 @@ def test_collision_term_excludes_flagged_direction_in_enumeration():
     # a symmetric model: every control has the same transitions, so only collision differs
     rng = np.random.default_rng(0)
     arrays, _ = random_dense(rng, (4,), (1,), (3,))
-    B = np.repeat(arrays.B[0], 4, axis=2)
+    B = np.repeat(arrays.B[0].prob, 4, axis=2)
     arrays = type(arrays)(**{**arrays.__dict__, "B": [B], "num_controls": (4,), "pB": None})
     qs = [np.ones(4) / 4]
     for blocked in range(4):

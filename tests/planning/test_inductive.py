@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from planning_builders import chain, graph_model
 
+from cogmap.genmodel.transitions import DenseTransitions
 from cogmap.planning import efe, inductive
 from cogmap.planning.arrays import prepare
 from cogmap.planning.context import LocalStep
@@ -70,7 +71,7 @@ def test_reachability_matches_pymdp_generate_I_matrix():
     H = np.zeros(9)
     H[8] = 1.0
     ref = np.asarray(generate_I_matrix([jnp.asarray(H)], [jnp.asarray(B)], 0.5, depth)[0])
-    src, dst = inductive.edges_dense(B, 0.5)
+    src, dst = DenseTransitions(B).edges(0.5, 9)
     ours = inductive.reachability_matrix(inductive.goal_distances(src, dst, H > 0, 9, depth), depth)
     np.testing.assert_array_equal(ours, ref)
 

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from cogmap.genmodel import SparseTransitions
 from cogmap.study.metrics_extra import (
     SuccessRule,
     drift_metrics,
@@ -128,14 +129,12 @@ def test_path_length_ratios_decompose_multiplicatively():
     assert fraction_within([1.1, 1.3, 1.6, None], 1.2) == pytest.approx(1 / 3)
 
 
-class _Sparse:
-    """Padded successor lists: succ/prob of shape (states, actions, slots)."""
-
-    def __init__(self, n, edges):
-        self.succ = np.tile(np.arange(n)[:, None, None], (1, 2, 1))
-        self.prob = np.ones((n, 2, 1))
-        for s, a, t, p in edges:
-            self.succ[s, a, 0], self.prob[s, a, 0] = t, p
+def _Sparse(n, edges):  # noqa: N802 - a small factory of padded successor lists
+    succ = np.tile(np.arange(n)[:, None, None], (1, 2, 1))
+    prob = np.ones((n, 2, 1))
+    for s, a, t, p in edges:
+        succ[s, a, 0], prob[s, a, 0] = t, p
+    return SparseTransitions(succ, prob)
 
 
 def test_graph_plan_length_on_a_square_with_a_weak_diagonal():
