@@ -64,6 +64,19 @@ class DenseTransitions:
         keep = src != dst
         return src[keep], dst[keep], self.prob[dst[keep], src[keep], u]
 
+    def learn_soft(self, q_next: np.ndarray, q_prev: np.ndarray, u: int, lr: float, n: int,
+                   floor: float = 1e-3) -> None:
+        """Eq. (8) for transitions under beliefs: ``counts[:, :, u] += lr * q_next (x) q_prev``
+        (touched counts floored at ``floor``), then the touched columns renormalised."""
+        if self.counts is None:
+            raise ValueError("these transitions have no Dirichlet counts to learn")
+        outer = lr * np.outer(q_next[:n], q_prev[:n])
+        block = self.counts[:n, :n, u] + outer
+        block = np.where(outer > 0, np.maximum(block, floor), block)
+        self.counts[:n, :n, u] = block
+        cols = np.flatnonzero(q_prev[:n] > 0)
+        self.prob[:n, cols, u] = block[:, cols] / block[:, cols].sum(axis=0, keepdims=True)
+
     def add_state(self, s: int, prior_count: float) -> None:
         """State ``s`` stays put under every control (counts ``prior_count`` on staying)."""
         self.prob[:, s, :] = 0.0

@@ -1,0 +1,154 @@
+"""An active-inference agent for any compiled model: ``init`` and ``step`` over a small state.
+
+    state = init(model, scheme="fpi", planner="enumerate", policy_len=2, gamma=16.0)
+    state, info = step(state, observation)      # infer -> learn (optional) -> plan -> act
+    info.action, info.q_pi, info.qs
+
+One ``step`` takes the observation of this time step (one entry per modality, an index or a
+distribution; a dict by name works too), infers the state posterior with the registered
+inference scheme, optionally learns ``A`` (Eq. 8: counts += lr * o (x) q) and ``B`` (counts +=
+lr * q_t (x) q_t-1 for the control taken; dense transitions), evaluates policies by expected
+free energy (enumeration of every policy of ``policy_len`` steps, or MCTS) and picks the next
+control. The prior of the next step is the posterior pushed through ``B`` under that control.
+
+The state is an immutable tuple; the model it holds is learnt in place when learning is on (as
+pymdp's ``Agent`` does). Policy precision ``gamma`` defaults to 16 (cogmap's planners); pymdp's
+``Agent`` defaults to 1: pass the same value to compare them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import NamedTuple
+
+import numpy as np
+
+from cogmap import inference
+from cogmap.genmodel import Model, SpecError
+from cogmap.inference.learning import learn_observation
+from cogmap.planning import efe
+from cogmap.planning.decide import decide as mcts_decide
+from cogmap.planning.mcts import MCTSConfig
+from cogmap.planning.policies import infer_policies
+
+PLANNERS = ("enumerate", "mcts")
+OBJECTIVES = {"pymdp": efe.pymdp_like, "explore": efe.exploration, "goal": efe.goal, "full": efe.full}
+
+
+class LoopConfig(NamedTuple):
+    scheme: str = "fpi"
+    planner: str = "enumerate"
+    policy_len: int = 1
+    gamma: float = 16.0
+    objective: efe.Objective | None = None
+    mcts: MCTSConfig | None = None
+    learn_A: bool = False
+    learn_B: bool = False
+    lr_A: float = 1.0
+    lr_B: float = 1.0
+    sample: bool = True  # sample the action from the policy posterior (False: its mode)
+    scheme_options: dict | None = None
+
+
+class LoopState(NamedTuple):
+    model: Model
+    config: LoopConfig
+    prior: list  # belief over each factor before this step's observation
+    qs: list | None  # posterior of the last step
+    action: tuple | None  # control chosen at the last step (one per factor)
+    rng: np.random.Generator
+    t: int
+
+
+class StepInfo(NamedTuple):
+    qs: list  # posterior per factor
+    action: tuple  # control per factor to apply now
+    q_pi: np.ndarray | None  # policy posterior (enumeration), None with MCTS
+    G: np.ndarray  # expected free energy per policy (enumeration) or per root action (MCTS)
+    policies: np.ndarray | None  # (P, T, F) policies of q_pi and G (enumeration)
+    free_energy: float  # variational free energy of this step's inference
+
+
+def init(
+    model: Model,
+    *,
+    scheme: str = "fpi",
+    planner: str = "enumerate",
+    policy_len: int = 1,
+    gamma: float = 16.0,
+    objective: efe.Objective | str | None = None,
+    mcts: MCTSConfig | None = None,
+    learn_A: bool = False,
+    learn_B: bool = False,
+    lr_A: float = 1.0,
+    lr_B: float = 1.0,
+    sample: bool = True,
+    seed: int = 0,
+    **scheme_options,
+) -> LoopState:
+    """A fresh agent on ``model``: the prior is ``D``. ``objective`` is an
+    :class:`~cogmap.planning.efe.Objective` or one of "pymdp" (utility + state information gain,
+    pymdp's default ``neg_efe``; the default), "explore", "goal", "full"; ``scheme_options``
+    go to the inference scheme (e.g. ``num_iter=16``)."""
+    if not isinstance(model, Model):
+        raise TypeError(f"init needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")
+    inference.get(scheme)  # unknown names fail here, listing the known ones
+    if planner not in PLANNERS:
+        raise ValueError(f"unknown planner '{planner}' (known: {', '.join(PLANNERS)})")
+    if not (isinstance(policy_len, int | np.integer) and policy_len >= 1):
+        raise ValueError(f"policy_len must be an integer >= 1, got {policy_len!r}")
+    if not (np.isfinite(gamma) and gamma > 0):
+        raise ValueError(f"gamma (policy precision) must be positive and finite, got {gamma!r}")
+    if isinstance(objective, str):
+        if objective not in OBJECTIVES:
+            raise ValueError(f"unknown objective '{objective}' (known: {', '.join(OBJECTIVES)} or an Objective)")
+        objective = OBJECTIVES[objective]()
+    if learn_A and not all(model.has_counts_A(m) for m in range(len(model.modalities))):
+        raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")
+    if learn_B and any(model.B[f].counts is None or model.is_sparse(f) for f in range(len(model.factors))):
+        raise SpecError("learn_B needs dense transitions with Dirichlet counts (pB) for every factor")
+    cfg = LoopConfig(scheme, planner, int(policy_len), float(gamma), objective or efe.pymdp_like(), mcts,
+                     learn_A, learn_B, lr_A, lr_B, sample, scheme_options or None)
+    prior = [model.live_D(f).copy() for f in range(len(model.factors))]
+    return LoopState(model, cfg, prior, None, None, np.random.default_rng(seed), 0)
+
+
+def _observation(model: Model, observation) -> list:
+    if isinstance(observation, Mapping):
+        out = [None] * len(model.modalities)
+        for name, value in observation.items():
+            out[model.modality_index(name)] = value
+        return out
+    if np.ndim(observation) == 0 and len(model.modalities) == 1:
+        return [observation]
+    if not isinstance(observation, Sequence | np.ndarray) or len(observation) != len(model.modalities):
+        raise ValueError(f"an observation has one entry per modality ({len(model.modalities)}), got {observation!r}")
+    return list(observation)
+
+
+def step(state: LoopState, observation) -> tuple[LoopState, StepInfo]:
+    """Infer, learn, plan and act for one observation; returns the next state and what happened."""
+    model, cfg = state.model, state.config
+    obs = _observation(model, observation)
+    qs, info = inference.get(cfg.scheme)(model, state.prior, [obs], **(cfg.scheme_options or {}))
+    qs = [np.asarray(q, dtype=float) for q in qs]
+    if cfg.learn_A:
+        for m, o in enumerate(obs):
+            if o is not None:
+                learn_observation(model, m, o, qs, lr=cfg.lr_A)
+    if cfg.learn_B and state.qs is not None:
+        for f, u in enumerate(state.action):
+            model.B[f].learn_soft(qs[f], state.qs[f], int(u), cfg.lr_B, model.num_states[f])
+    if cfg.planner == "enumerate":
+        action, q_pi, G, policies = infer_policies(model, qs, cfg.objective, length=cfg.policy_len, gamma=cfg.gamma,
+                                                   rng=state.rng if cfg.sample else None)
+        action = tuple(int(a) for a in action)
+    else:
+        mcfg = cfg.mcts or MCTSConfig(gamma=cfg.gamma)
+        d = mcts_decide(model, qs, None, cfg.objective, config=mcfg, rng=state.rng)
+        a = np.atleast_1d(np.asarray(d.action, dtype=int))
+        action = tuple(int(x) for x in a) + (0,) * (len(model.factors) - a.size)
+        q_pi, G, policies = None, np.asarray(d.Q), None
+    prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
+    nxt = state._replace(prior=prior, qs=qs, action=action, t=state.t + 1)
+    return nxt, StepInfo(qs, action, q_pi, G, policies, float(info.free_energy))
