@@ -34,13 +34,16 @@ def _goal(args) -> int:
 def _compare(args) -> int:
     import numpy as np
 
-    from .compare import compare_inference, format_table, generate_sequence
-    from .demo_models import MODELS
+    from .compare import compare_inference, format_table, generate_sequence, load_model
 
-    if args.model not in MODELS:
-        print(f"unknown model {args.model!r}; choose from {sorted(MODELS)}", file=sys.stderr)
+    if args.steps < 1:
+        print(f"cogmap compare-inference: --steps must be at least 1, got {args.steps}", file=sys.stderr)
         return 2
-    model = MODELS[args.model](np.random.default_rng(args.seed))
+    try:
+        model = load_model(args.model, np.random.default_rng(args.seed))
+    except (ValueError, ImportError, AttributeError, TypeError, OSError) as err:
+        print(f"cogmap compare-inference: {err}", file=sys.stderr)
+        return 2
     seq = generate_sequence(model, T=args.steps, seed=args.seed)
     rows = compare_inference(model, seq.observations, seq.actions, true_states=seq.states)
     print(format_table(rows))
@@ -85,7 +88,9 @@ def build_parser() -> argparse.ArgumentParser:
     g.set_defaults(func=_goal)
 
     c = sub.add_parser("compare-inference", help="run every registered inference scheme on one model")
-    c.add_argument("--model", default="tmaze", help="built-in model: tmaze, corridor or random")
+    c.add_argument("--model", default="tmaze",
+                   help="a built-in model (tmaze, corridor, random), a saved model (PATH of its .npz/.json) "
+                        "or a factory (module:function returning a compiled Model)")
     c.add_argument("--steps", type=int, default=30)
     c.add_argument("--seed", type=int, default=0)
     c.set_defaults(func=_compare)

@@ -17,6 +17,7 @@ from .base import (
 from .bayes_filter import bayes_filter
 from .exact import exact
 from .fpi import fpi
+from .free_energy import window_free_energy
 from .message_passing import mmp, vmp
 from .pymdp_bridge import to_pymdp
 from .registry import available, get, register, unregister
@@ -43,4 +44,5 @@ __all__ = [
     "to_pymdp",
     "unregister",
     "vmp",
+    "window_free_energy",
 ]

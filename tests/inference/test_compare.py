@@ -31,5 +31,36 @@ def test_harness_single_factor_with_pose_and_window():
     for r in rows:
         assert r.kl < 1e-10 and not r.error
         assert r.accuracy == 1.0  # against the exact MAP
-    text = format_table(rows)
-    assert text.count("\n") == 4
+    table, legend = format_table(rows).split("\n\n")
+    assert table.count("\n") == 4 and "upper bound on -log p(o_1:T)" in legend
+
+
+def test_no_scheme_reports_a_free_energy_below_exact_on_random_models():
+    from inference_helpers import brute_force_log_evidence
+
+    cases = [dict(sizes=(3,), modalities=((0,),)), dict(sizes=(3, 2), modalities=((0,), (0, 1))),
+             dict(sizes=(2, 2, 2), modalities=((0, 1), (2,), (1, 2)))]
+    for seed in range(4):
+        for case in cases:
+            m = random_model(seed, **case)
+            seq = generate_sequence(m, 4, seed=seed)
+            rows = {r.scheme: r for r in compare_inference(m, seq.observations, seq.actions)}
+            prior = [m.live_D(f) for f in range(len(m.factors))]
+            log_evidence = brute_force_log_evidence(m, prior, seq.observations, seq.actions)
+            assert abs(rows["exact"].free_energy + log_evidence) < 1e-9  # exact: F = -log p(o_1:T)
+            for name, r in rows.items():
+                if not r.error:
+                    assert r.free_energy >= rows["exact"].free_energy - 1e-9, (name, seed, case)
+
+
+def test_window_free_energy_of_exact_smoothed_marginals_bounds_the_evidence():
+    from inference_helpers import brute_force_log_evidence, brute_force_marginals
+
+    from cogmap.inference import window_free_energy
+
+    m = random_model(1, sizes=(4,), modalities=((0,),))
+    seq = generate_sequence(m, 4, seed=2)
+    prior = [m.live_D(0)]
+    marg = brute_force_marginals(m, prior, seq.observations, seq.actions)
+    F = window_free_energy(m, prior, seq.observations, seq.actions, marg)
+    assert F >= -brute_force_log_evidence(m, prior, seq.observations, seq.actions) - 1e-12

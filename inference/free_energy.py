@@ -1,0 +1,39 @@
+"""The variational free energy of a whole window under any scheme's posterior marginals.
+
+For marginals ``q_t^f`` (time ``t``, factor ``f``), read as the mean-field posterior
+``q(s_1:T) = prod_t prod_f q_t^f(s_t^f)``::
+
+    F[q] = sum_t sum_f E[log q_t^f] - sum_f E[log D_f(s_1^f)] - sum_t>1 sum_f E[log B_f(s_t^f | s_t-1^f, u_t-1)]
+           - sum_t sum_m E[log A_m(o_t^m | s_t)]
+
+Gibbs' inequality makes it an upper bound on ``-log p(o_1:T)`` for any marginals, with
+equality only for the exact posterior when it factorises; so free energies of different schemes
+on the same data are comparable, and none can fall below exact Bayes' ``-log p(o_1:T)``.
+Logarithms are floored at machine epsilon, as in the schemes themselves.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import dense_transition, expected_loglik, floor_log, prepare, xlogx_sum
+
+
+def window_free_energy(model, prior, observations, actions, marginals) -> float:
+    """``F[q]`` above for ``marginals[t][f]`` (live sizes) over the whole ``observations``."""
+    prob = prepare(model, prior, observations, actions)
+    if len(marginals) != prob.T:
+        raise ValueError(f"marginals cover {len(marginals)} steps, the observations {prob.T}")
+    fe = 0.0
+    for t in range(prob.T):
+        q_t = [np.asarray(q, dtype=float) for q in marginals[t]]
+        for f in range(prob.num_factors):
+            fe += xlogx_sum(q_t[f])
+            if t == 0:
+                fe -= float(q_t[f] @ floor_log(prob.prior[f]))
+            else:
+                logB = floor_log(dense_transition(model, f, prob.actions[t - 1][f]))
+                fe -= float(q_t[f] @ logB @ np.asarray(marginals[t - 1][f], dtype=float))
+        for ev in prob.evidence[t]:
+            fe -= expected_loglik(floor_log(ev.lik), ev.deps, q_t) + ev.log_scale
+    return fe
