@@ -50,10 +50,10 @@ class Crown:
 @dataclass(frozen=True)
 class FieldConfig:
     half_size: float = 100.0  # the field spans [-half, half]^2
-    n_houses: int = 45
-    n_trees: int = 110
-    n_alleys: int = 4
-    n_bands: int = 2
+    n_houses: int = 80
+    n_trees: int = 350
+    n_alleys: int = 6
+    n_bands: int = 5
     clear_radius: float = 6.0  # around the start
     start_altitude: float = 3.0
 

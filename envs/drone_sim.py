@@ -201,9 +201,9 @@ class DroneSim:
         """Fly straight to ``waypoint`` at ``speed`` (m/s) with dt sub-steps.
 
         Stops early on a collision (counted; the drone stays at its last free position) or, when
-        ``replan_distance`` is given, once a LiDAR scan taken every ``scan_every`` sub-steps shows
-        an obstacle within that distance that is nearer than at the segment's start (an obstacle
-        *coming* within range). ``on_scan(scan, position)`` sees every in-flight scan.
+        ``replan_distance`` is given, once a LiDAR scan taken in flight every ``scan_every``
+        sub-steps shows an obstacle within that distance (the original's "obstacle_detected"
+        replan). ``on_scan(scan, position)`` sees every in-flight scan.
         """
         c = self.config
         v = c.speed if speed is None else float(speed)
@@ -215,13 +215,7 @@ class DroneSim:
         path = [start.copy()]
         collided = replanned = False
         t0 = self.time
-        start_clear = np.inf
         min_clear = np.inf
-        if replan_distance is not None:
-            s = self.scan(start)
-            start_clear = min_clear = s.min_range
-            if on_scan is not None:
-                on_scan(s, start)
         k = 0
         for k in range(1, n + 1):
             nxt = start + delta * (k / n)
@@ -240,7 +234,7 @@ class DroneSim:
                 min_clear = min(min_clear, s.min_range)
                 if on_scan is not None:
                     on_scan(s, nxt)
-                if s.min_range < replan_distance and s.min_range < start_clear - 0.25:
+                if s.min_range < replan_distance:
                     replanned = True
                     break
         self._place(self.position)

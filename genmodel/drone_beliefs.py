@@ -11,6 +11,7 @@ Observations are continuous values; the Gaussian-kernel update that turns them i
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -32,9 +33,11 @@ class BinnedFactor:
         if self.n < 2 or not self.hi > self.lo:
             raise ValueError(f"factor '{self.name}': need n >= 2 and hi > lo (got n={self.n}, [{self.lo}, {self.hi}])")
 
-    @property
+    @cached_property
     def bins(self) -> np.ndarray:
-        return np.linspace(self.lo, self.hi, self.n)
+        b = np.linspace(self.lo, self.hi, self.n)
+        b.flags.writeable = False
+        return b
 
     def difference(self, obs: float) -> np.ndarray:
         """bin - obs, wrapped to (-pi, pi] for circular factors."""

@@ -43,8 +43,9 @@ def voxelise(points, voxel: float = VOXEL_SIZE, min_points: int = MIN_POINTS) ->
         raise ValueError(f"voxelise: min_points must be >= 1, got {min_points}")
     if len(pts) == 0:
         return np.zeros((0, 3))
-    keys = np.floor(pts / voxel).astype(np.int64)
-    _, inv, counts = np.unique(keys, axis=0, return_inverse=True, return_counts=True)
+    ijk = np.floor(pts / voxel).astype(np.int64) + (1 << 20)  # +-157 km at 0.15 m fits 21 bits
+    keys = (ijk[:, 0] << 42) | (ijk[:, 1] << 21) | ijk[:, 2]
+    _, inv, counts = np.unique(keys, return_inverse=True, return_counts=True)
     inv = inv.reshape(-1)
     sums = np.zeros((len(counts), 3))
     np.add.at(sums, inv, pts)
@@ -85,6 +86,11 @@ def suitability(d, rho):
     return float(s) if s.ndim == 0 else s
 
 
+def _sq_dists(A, V) -> np.ndarray:
+    """Squared distances (N, M) between rows of A and V, by the |a|^2 + |v|^2 - 2 a.v expansion."""
+    return np.maximum((A * A).sum(1)[:, None] + (V * V).sum(1)[None, :] - 2.0 * A @ V.T, 0.0)
+
+
 def segments_clear(starts, end, voxels, margin: float = 1.5) -> np.ndarray:
     """Per start point (N, 3): True when no voxel lies within ``margin`` of the segment start -> end
     (the 'direct path is clear' test of simulate_transition)."""
@@ -92,12 +98,12 @@ def segments_clear(starts, end, voxels, margin: float = 1.5) -> np.ndarray:
     v = np.asarray(voxels, float).reshape(-1, 3)
     if len(v) == 0 or len(A) == 0:
         return np.ones(len(A), bool)
-    b = np.asarray(end, float)
-    ab = b - A  # (N, 3)
+    ab = np.asarray(end, float) - A  # (N, 3)
     L2 = np.maximum((ab * ab).sum(1), 1e-12)
-    t = np.clip(((v[None, :, :] - A[:, None, :]) * ab[:, None, :]).sum(2) / L2[:, None], 0.0, 1.0)
-    closest = A[:, None, :] + t[..., None] * ab[:, None, :]
-    return (((v[None] - closest) ** 2).sum(2) > margin * margin).all(1)
+    proj = v @ ab.T - (A * ab).sum(1)[None, :]  # (M, N): (v - a).ab
+    t = np.clip(proj / L2[None, :], 0.0, 1.0)
+    d2 = _sq_dists(A, v).T - 2.0 * t * proj + t * t * L2[None, :]  # |v - a - t ab|^2
+    return (d2 > margin * margin).all(0)
 
 
 def segment_clear(a, b, voxels, margin: float = 1.5) -> bool:
@@ -123,14 +129,13 @@ def waypoint_suitability(waypoints, voxels, d_obs_now: float, target, position) 
     d = np.full(n, float(d_obs_now))
     rho = np.zeros(n)
     if len(v):
-        diff = v[None, :, :] - W[:, None, :]
-        dist2 = (diff ** 2).sum(2)
+        dist2 = _sq_dists(W, v)
         d = np.minimum(d, np.sqrt(dist2.min(1)))
         near3 = dist2 <= WAYPOINT_DENSITY_RADIUS ** 2
         nearby = near3.sum(1)
         rho = nearby / WAYPOINT_DENSITY_VOLUME
         rows, cols = np.nonzero(dist2 <= 25.0)
-        dv = diff[rows, cols]
+        dv = v[cols] - W[rows]
         octant = (dv[:, 0] > 0) * 4 + (dv[:, 1] > 0) * 2 + (dv[:, 2] > 0)
         max_oct = np.bincount(rows * 8 + octant, minlength=8 * n).reshape(n, 8).max(1)
         inflate = (nearby > 5) & (max_oct > 5)

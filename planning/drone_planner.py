@@ -46,8 +46,8 @@ class PlanResult:
     efe: np.ndarray  # shaped EFE of the returned waypoints
     suitability: np.ndarray  # per-waypoint S of the returned waypoints
     radius: float
-    n_candidates: int
-    n_kept: int
+    n_candidates: int  # generated (with the ring's repeated up/down points)
+    n_kept: int  # distinct candidates that passed the filter
     rule: str  # which filter rule kept the candidates
     efe_us_per_candidate: float  # microseconds of the EFE (preference, EFE, shaping) per candidate
 
@@ -64,11 +64,15 @@ def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: fl
     r = waypoint_radius(s_now, rho, d_obs, d_now)
     n = waypoint_count(s_now, rho, d_obs, d_now)
     W = candidate_waypoints(pos, tgt, r, n, rng, cfg.min_altitude)
+    n_generated = len(W)
+    # the ring's +-pi/2 rows repeat the straight-up and straight-down points (a quirk of the
+    # original): score each point once; repeated points would only tie with themselves
+    _, first = np.unique(W.round(9), axis=0, return_index=True)
+    W = W[np.sort(first)]
     V = np.asarray(voxels, float).reshape(-1, 3)
     if len(V):
         V = V[((V - pos) ** 2).sum(1) <= (r + cfg.voxel_horizon) ** 2]
     S = waypoint_suitability(W, V, d_obs, tgt, pos)
-    n_total = len(W)
     if cfg.use_filter:
         keep, rule = filter_waypoints(W, S, pos, tgt, rho, path_clear=lambda idx: segments_clear(W[idx], tgt, V))
     else:
@@ -93,4 +97,4 @@ def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: fl
     score, order = E.rank(S[pool], G[pool], s_now)
     k = max(1, policy_length(s_now))
     top = pool[order[:k]]
-    return PlanResult(W[top], score[order[:k]], G[top], S[top], r, n_total, int(len(W)), rule, efe_us)
+    return PlanResult(W[top], score[order[:k]], G[top], S[top], r, n_generated, int(len(W)), rule, efe_us)

@@ -120,12 +120,14 @@ class DroneAgent:
         return V, d_obs, rho, float(suitability(d_obs, rho))
 
     def decide(self, position, target) -> Decision:
-        t0 = time.perf_counter()
         pos = np.asarray(position, float)
         tgt = np.asarray(target, float)
         if self.d_start is None:
             self.d_start = float(np.linalg.norm(tgt - pos))
         V, d_obs, rho, S = self.sense(pos)
+        # the planning call, timed as the original's server round trip: beliefs, candidates,
+        # per-waypoint suitability, filter, EFE, ranking (perception ran on the client before)
+        t0 = time.perf_counter()
         # moveToPositionAsync keeps the take-off yaw, so the egocentric frame is the world frame
         obs = {**egocentric_state(pos, tgt, 0.0), "suitability": S, "density": min(rho, 1.0)}
         prior = self.beliefs if self.config.persistent_beliefs else None

@@ -146,4 +146,6 @@ def test_plan_in_open_space_heads_for_the_target_and_steps_at_least_1m():
     wall = np.stack([xs.ravel(), np.full(xs.size, 4.0), zs.ravel()], 1)
     no_filter = plan_waypoints(pos, tgt, wall, 4.0, 0.0, suitability(4.0, 0.0), 6.0, 40.0,
                                np.random.default_rng(0), DronePlannerConfig(use_filter=False))
-    assert no_filter.rule == "no filter" and no_filter.n_kept == no_filter.n_candidates
+    n_ring = round(0.7 * waypoint_count(suitability(4.0, 0.0), 0.0, 4.0, 40.0))
+    # every distinct candidate is kept; the ring's repeated up/down points are scored once
+    assert no_filter.rule == "no filter" and no_filter.n_kept == no_filter.n_candidates - 2 * (n_ring - 1)
