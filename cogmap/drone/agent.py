@@ -24,6 +24,7 @@ from cogmap.genmodel.drone_beliefs import (
     normalised_entropy,
 )
 from cogmap.genmodel.suitability import MIN_POINTS, VOXEL_SIZE, clearance, density, suitability, voxelise
+from cogmap.planning.drone_lookahead import LookaheadConfig, plan_sequence
 from cogmap.planning.drone_planner import DronePlannerConfig, PlanResult, plan_waypoints
 
 SENSE_RADIUS = 20.0  # the LiDAR's range: only voxels this close describe the current state
@@ -72,6 +73,7 @@ class DroneAgentConfig:
     replan_distance: float = 2.0  # replan when an obstacle comes within this in flight
     near_goal: float = 10.0  # slow down within this distance of the target
     dense: float = 0.1  # ... or when the density exceeds this
+    depth: int = 1  # 1: the paper's one-step ranking; 2 or 3: EFE over waypoint sequences (beyond the paper)
 
     def to_dict(self) -> dict:
         from dataclasses import asdict
@@ -134,8 +136,12 @@ class DroneAgent:
         beliefs, _ = self.scheme(self.model, prior, [obs])
         self.beliefs = beliefs
         H = [entropy(b) for b in beliefs]
-        plan = plan_waypoints(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
-                              self.config.planner)
+        if self.config.depth > 1:
+            plan, _ = plan_sequence(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
+                                    self.config.planner, LookaheadConfig(depth=self.config.depth))
+        else:
+            plan = plan_waypoints(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
+                                  self.config.planner)
         plan_ms = 1e3 * (time.perf_counter() - t0)
         d_tgt = float(np.linalg.norm(tgt - pos))
         slow = d_tgt < self.config.near_goal or rho > self.config.dense

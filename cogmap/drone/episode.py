@@ -28,7 +28,8 @@ class EpisodeLimits:
 
 def make_policy(method: str, seed: int = 0):
     """The policy of a method name: ``agent`` (hierarchical AIF), ``agent_persistent`` (beliefs
-    kept across steps), ``no_filter``, ``no_epistemic``, ``straight``, ``potential``."""
+    kept across steps), ``no_filter``, ``no_epistemic``, ``agent_depth2`` / ``agent_depth3`` (EFE over
+    waypoint sequences), ``straight``, ``potential``."""
     from dataclasses import replace
 
     from .agent import DroneAgent, DroneAgentConfig
@@ -43,6 +44,8 @@ def make_policy(method: str, seed: int = 0):
         return DroneAgent(replace(base, planner=replace(base.planner, use_filter=False)), seed)
     if method == "no_epistemic":
         return DroneAgent(replace(base, planner=replace(base.planner, w_epistemic=0.0)), seed)
+    if method in ("agent_depth2", "agent_depth3"):
+        return DroneAgent(replace(base, depth=int(method[-1])), seed)
     if method == "straight":
         return StraightLine()
     if method == "potential":
@@ -50,7 +53,8 @@ def make_policy(method: str, seed: int = 0):
     raise ValueError(f"unknown drone method {method!r}; choose from {METHODS}")
 
 
-METHODS = ("agent", "agent_persistent", "no_filter", "no_epistemic", "straight", "potential")
+METHODS = ("agent", "agent_persistent", "no_filter", "no_epistemic", "agent_depth2", "agent_depth3", "straight",
+           "potential")
 
 
 def _stuck(times, positions, now: float, window: float, dist: float) -> bool:

@@ -10,7 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-METHODS = ("agent", "straight", "potential", "no_filter", "no_epistemic", "agent_persistent")
+METHODS = ("agent", "straight", "potential", "no_filter", "no_epistemic", "agent_persistent", "agent_depth2",
+           "agent_depth3")
 LEVELS = {"continue": False, "end": True}  # does a collision end the episode?
 FIELD_SEED = 0
 EPISODES = {"full": 149, "reduced": 20, "tiny": 2}

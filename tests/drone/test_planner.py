@@ -149,3 +149,26 @@ def test_plan_in_open_space_heads_for_the_target_and_steps_at_least_1m():
     n_ring = round(0.7 * waypoint_count(suitability(4.0, 0.0), 0.0, 4.0, 40.0))
     # every distinct candidate is kept; the ring's repeated up/down points are scored once
     assert no_filter.rule == "no filter" and no_filter.n_kept == no_filter.n_candidates - 2 * (n_ring - 1)
+
+
+def test_lookahead_adds_the_best_continuation_and_prunes_blocked_segments():
+    from cogmap.genmodel.suitability import clearance, density
+    from cogmap.planning.drone_lookahead import LookaheadConfig, _segment_distance, plan_sequence
+
+    pos, tgt = np.array([0.0, 0, 5]), np.array([0.0, 40, 5])
+    s_now = suitability(10.0, 0.0)
+    V0 = np.zeros((0, 3))
+    res, values = plan_sequence(pos, tgt, V0, 10.0, 0.0, s_now, 6.0, 40.0, np.random.default_rng(0),
+                                lookahead=LookaheadConfig(depth=2))
+    w1 = res.actions[0]
+    np.testing.assert_allclose(w1, [0.0, waypoint_radius(s_now, 0.0, 10.0, 40.0), 5.0], atol=1e-9)  # direct step
+    d1 = clearance(w1, V0)
+    nxt = plan_waypoints(w1, tgt, V0, d1, density(w1, V0), suitability(d1, 0.0), 6.0, 40.0, np.random.default_rng(5))
+    assert values[0] == pytest.approx(res.efe[0] + nxt.efe[0])
+    assert _segment_distance(np.zeros(3), np.array([4.0, 0, 0]), np.array([[2.0, 0.3, 0]])) == pytest.approx(0.3)
+    # a thin pole right on the direct path: the direct step is pruned even though its end point is clear
+    pole = np.stack([np.zeros(20), np.full(20, 1.0), np.linspace(0, 9, 20)], 1)
+    d_obs = clearance(pos, pole)
+    blocked, _ = plan_sequence(pos, tgt, pole, d_obs, density(pos, pole), suitability(d_obs, 0.0), 6.0, 40.0,
+                               np.random.default_rng(0), lookahead=LookaheadConfig(depth=2))
+    assert all(_segment_distance(pos, w, pole) >= 0.5 for w in blocked.actions)
