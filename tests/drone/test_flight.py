@@ -64,3 +64,12 @@ def test_episode_targets_are_seeded():
         assert not np.array_equal(episode_target(sim, 0, 3), episode_target(sim, 0, 4))
     finally:
         sim.close()
+
+
+def test_depth2_avoids_the_crash_of_the_one_step_agent():
+    # field 0, episode 81 with collisions ending the episode: the one-step ranking flies into an
+    # obstacle on step 14; scoring two-step sequences (and pruning blocked segments) gets through
+    one = fly_run(0, 1, None, method="agent", end_on_collision=True, first_episode=81)["episodes"][0]
+    two = fly_run(0, 1, None, method="agent_depth2", end_on_collision=True, first_episode=81)["episodes"][0]
+    assert one["outcome"] == "crashed" and one["collisions"] == 1
+    assert two["outcome"] == "success" and two["collisions"] == 0
