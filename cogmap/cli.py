@@ -1,5 +1,5 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap reproduce``."""
+``cogmap drone fly``, ``cogmap reproduce``."""
 
 from __future__ import annotations
 
@@ -50,6 +50,18 @@ def _compare(args) -> int:
     return 0
 
 
+def _drone_fly(args) -> int:
+    from .drone.run import fly_run
+
+    res = fly_run(args.seed, args.episodes, args.out, method=args.method, end_on_collision=args.end_on_collision,
+                  pictures=args.pictures, progress=not args.quiet, first_episode=args.first_episode)
+    s = res["summary"]
+    print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in s.items()}, indent=1))
+    if args.out:
+        print(f"run written to {args.out}/ (flight.csv, metrics.json, run.json, flight_*_top.png, flight_*_side.png)")
+    return 0
+
+
 def _reproduce(args) -> int:
     from .study.runner import run_from_args
 
@@ -94,6 +106,21 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--steps", type=int, default=30)
     c.add_argument("--seed", type=int, default=0)
     c.set_defaults(func=_compare)
+
+    from .drone.episode import METHODS as DRONE_METHODS
+
+    d = sub.add_parser("drone", help="the hierarchical active-inference drone in a 3D pybullet obstacle field")
+    dsub = d.add_subparsers(dest="drone_command", required=True)
+    f = dsub.add_parser("fly", help="fly seeded episodes and write a run directory")
+    f.add_argument("--seed", type=int, default=0, help="field seed; episode i's target is drawn from (seed, i)")
+    f.add_argument("--episodes", type=int, default=1)
+    f.add_argument("--first-episode", type=int, default=0, help="index of the first episode (default: 0)")
+    f.add_argument("--method", default="agent", choices=DRONE_METHODS)
+    f.add_argument("--end-on-collision", action="store_true", help="a collision ends the episode (the honest setting)")
+    f.add_argument("--pictures", type=int, default=3, help="top/side PNGs of the first N episodes (default: 3)")
+    f.add_argument("--out", default=None, help="run directory (default: print the summary only)")
+    f.add_argument("--quiet", action="store_true")
+    f.set_defaults(func=_drone_fly)
 
     from .study.runner import build_parser as study_arguments
 

@@ -18,6 +18,8 @@ LAYOUT_IDS = {
 }
 GRID_ID = "cogmap/GridWorld-v0"
 ALL_IDS = (*LAYOUT_IDS, GRID_ID)
+DRONE_ID = "cogmap/DroneField-v0"
+DRONE_MAX_STEPS = 250
 
 
 def register_all() -> None:
@@ -29,3 +31,6 @@ def register_all() -> None:
     if GRID_ID not in gym.registry:
         gym.register(GRID_ID, entry_point="cogmap.envs.gridworld:GridWorldEnv",
                      max_episode_steps=MAX_STEPS)
+    if DRONE_ID not in gym.registry:
+        gym.register(DRONE_ID, entry_point="cogmap.envs.drone_gym:DroneFieldEnv",
+                     max_episode_steps=DRONE_MAX_STEPS)

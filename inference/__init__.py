@@ -2,7 +2,9 @@
 
 Every scheme: ``posterior, info = scheme(model, prior, observations, actions=None, **options)``
 (conventions in :mod:`cogmap.inference.base`). Built-in names: ``exact``, ``filter``
-(:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``; ``get(name)``, ``register(name, fn)``, ``available()``.
+(:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``, ``kernel``
+(:func:`kernel_filter`, the drone's Gaussian-kernel update over binned factors);
+``get(name)``, ``register(name, fn)``, ``available()``.
 """
 
 from .base import (
@@ -18,11 +20,13 @@ from .bayes_filter import bayes_filter
 from .exact import exact
 from .fpi import fpi
 from .free_energy import window_free_energy
+from .kernel_filter import kernel_filter
 from .message_passing import mmp, vmp
 from .pymdp_bridge import to_pymdp
 from .registry import available, get, register, unregister
 
-_BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp))
+_BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp),
+            ("kernel", kernel_filter))
 for _name, _fn in _BUILTIN:
     register(_name, _fn)
 
@@ -37,6 +41,7 @@ __all__ = [
     "exact",
     "fpi",
     "get",
+    "kernel_filter",
     "mmp",
     "predict_factorised",
     "prepare",

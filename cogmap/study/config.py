@@ -8,7 +8,7 @@ import json
 
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
-STUDIES = ("exploration", "success", "goals", "drift", "slip", "dropout", "obstacle", "scaling")
+STUDIES = ("exploration", "success", "goals", "drift", "slip", "dropout", "obstacle", "scaling", "drone")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -89,6 +89,10 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         raise ValueError(f"unknown study {study!r}; choose from {STUDIES}")
     if scale not in ("reduced", "full", "tiny"):
         raise ValueError("scale must be 'reduced', 'full' or 'tiny'")
+    if study == "drone":  # episodes in a 3D field, not rooms: its own plan (cogmap.study.drone)
+        from .drone import drone_plan
+
+        return drone_plan(scale, seeds=seeds, methods=methods, envs=envs)
     full = scale == "full"
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
@@ -172,6 +176,10 @@ def run_specs(plan: dict) -> list[dict]:
     run."""
     from cogmap.explore import layout_name
 
+    if plan["study"] == "drone":
+        from .drone import drone_specs
+
+        return drone_specs(plan)
     unknown = [m for m in plan["methods"] if m not in METHOD_OPTIONS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; choose from {list(METHOD_OPTIONS)}")

@@ -493,6 +493,15 @@ REPORTS = {"exploration": exploration_report, "success": success_report, "goals"
            "obstacle": obstacle_report, "scaling": scaling_report}
 
 
+def _drone_report(study_dir: Path, plan, results) -> str:
+    from .drone import drone_report
+
+    return drone_report(study_dir, plan, results)
+
+
+REPORTS["drone"] = _drone_report
+
+
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
     study_dir = Path(study_dir)
     body = REPORTS[name](study_dir, plan, results)

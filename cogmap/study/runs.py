@@ -24,7 +24,7 @@ from .metrics_extra import (
     transitions_into,
 )
 
-TIMING_SUFFIXES = ("_ms", "_s")
+TIMING_SUFFIXES = ("_ms", "_s", "_us")
 
 
 def _clean(x):
@@ -340,8 +340,15 @@ def run_scaling(spec) -> dict:
         sim.close()
 
 
+def run_drone(spec) -> dict:
+    from .drone import run_drone as run
+
+    return run(spec)
+
+
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
-           "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling}
+           "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
+           "drone": run_drone}
 
 
 _DIGEST: str | None = None

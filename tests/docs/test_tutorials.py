@@ -6,7 +6,8 @@ from pathlib import Path
 import pytest
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
-PAGES = ["tutorial-generative-model.md", "quickstart.md", "tutorial-aimapp.md", "plan-and-act.md"]
+PAGES = ["tutorial-generative-model.md", "quickstart.md", "tutorial-aimapp.md", "plan-and-act.md",
+         "tutorial-drone.md"]
 
 
 def blocks(page: str) -> list[str]:

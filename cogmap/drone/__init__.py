@@ -1,0 +1,15 @@
+"""The hierarchical active-inference drone: agent shell, baselines, episodes and runs.
+
+The maths lives in the libraries: suitability and binned factors in ``cogmap.genmodel``
+(:mod:`~cogmap.genmodel.suitability`, :mod:`~cogmap.genmodel.drone_beliefs`), the Gaussian-kernel
+belief update as the ``"kernel"`` inference scheme, waypoint generation, filtering and EFE ranking in
+``cogmap.planning`` (:mod:`~cogmap.planning.drone_planner`), the field, drone and LiDAR in
+``cogmap.envs`` (:mod:`~cogmap.envs.drone_sim`).
+"""
+
+from .agent import DroneAgent, DroneAgentConfig, VoxelMap
+from .baselines import PotentialField, StraightLine
+from .episode import EpisodeLimits, fly_episode, make_policy, summarise
+
+__all__ = ["DroneAgent", "DroneAgentConfig", "EpisodeLimits", "PotentialField", "StraightLine", "VoxelMap",
+           "fly_episode", "make_policy", "summarise"]

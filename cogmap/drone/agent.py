@@ -1,0 +1,153 @@
+"""`DroneAgent`: the stateful shell that wires perception, kernel beliefs and the waypoint planner.
+
+Per decision (as the published planning server): sense (voxels, clearance d_obs, density rho,
+suitability S), update the kernel beliefs over (distance, azimuth, elevation, suitability, density)
+with the ``"kernel"`` scheme (re-initialised on every call by default, as published; persistent with
+``persistent_beliefs=True``), plan candidates and rank them, and return the first action. The agent
+holds state (voxel memory, beliefs, RNG) and no maths.
+"""
+
+from __future__ import annotations
+
+import time
+from collections import deque
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from cogmap import inference
+from cogmap.genmodel.drone_beliefs import (
+    KernelBeliefModel,
+    egocentric_state,
+    entropy,
+    expected_state,
+    normalised_entropy,
+)
+from cogmap.genmodel.suitability import MIN_POINTS, VOXEL_SIZE, clearance, density, suitability, voxelise
+from cogmap.planning.drone_lookahead import LookaheadConfig, plan_sequence
+from cogmap.planning.drone_planner import DronePlannerConfig, PlanResult, plan_waypoints
+
+SENSE_RADIUS = 20.0  # the LiDAR's range: only voxels this close describe the current state
+
+
+class VoxelMap:
+    """Obstacle voxels (0.15 m) of the last ``memory`` LiDAR scans.
+
+    ``memory=1`` is the original's per-scan view. With 400 rays a single sweep leaves 14.4 deg between
+    azimuths (1.3 m at 5 m range, enough to miss a trunk), and each scan turns the pattern by a
+    golden-ratio fraction of that spacing, so a short memory of recent scans (default 12, the scans
+    of about 2-3 planning steps with the in-flight ones) fills the gaps while keeping the voxel count,
+    and so the planning time, bounded. Voxels seen in several scans count once.
+    """
+
+    def __init__(self, voxel: float = VOXEL_SIZE, min_points: int = MIN_POINTS, memory: int = 12):
+        if memory < 1:
+            raise ValueError(f"VoxelMap: memory must be >= 1 scan, got {memory}")
+        self.voxel, self.min_points = voxel, min_points
+        self.scans: deque = deque(maxlen=memory)
+        self._points = None
+
+    def add(self, hits) -> None:
+        self.scans.append(np.asarray(hits, float).reshape(-1, 3))
+        self._points = None
+
+    @property
+    def points(self) -> np.ndarray:
+        if self._points is None:
+            pts = np.vstack(list(self.scans)) if self.scans else np.zeros((0, 3))
+            self._points = voxelise(pts, self.voxel, self.min_points)
+        return self._points
+
+    def near(self, position, radius: float = SENSE_RADIUS) -> np.ndarray:
+        P = self.points
+        if len(P) == 0:
+            return P
+        return P[((P - np.asarray(position, float)) ** 2).sum(1) <= radius * radius]
+
+
+@dataclass(frozen=True)
+class DroneAgentConfig:
+    planner: DronePlannerConfig = field(default_factory=DronePlannerConfig)
+    persistent_beliefs: bool = False  # False: per-call re-initialisation, as published
+    scan_memory: int = 12  # LiDAR scans whose voxels describe the surroundings (1: per-scan)
+    replan_distance: float = 2.0  # replan when an obstacle comes within this in flight
+    near_goal: float = 10.0  # slow down within this distance of the target
+    dense: float = 0.1  # ... or when the density exceeds this
+    depth: int = 1  # 1: the paper's one-step ranking; 2 or 3: EFE over waypoint sequences (beyond the paper)
+
+    def to_dict(self) -> dict:
+        from dataclasses import asdict
+
+        return asdict(self)
+
+
+@dataclass
+class Decision:
+    waypoint: np.ndarray
+    speed: float
+    plan: PlanResult
+    plan_ms: float  # wall-clock of the whole planning call (beliefs + candidates + EFE + ranking)
+    state: dict  # d_obs, rho, S, expected state, entropies
+
+
+class DroneAgent:
+    """See the module docstring. ``observe(scan)`` feeds LiDAR sweeps (also those taken in flight);
+    ``decide(position, target)`` returns a :class:`Decision`."""
+
+    replans_in_flight = True
+
+    def __init__(self, config: DroneAgentConfig | None = None, seed: int = 0, speeds=(2.0, 1.5)):
+        self.config = config or DroneAgentConfig()
+        self.model = KernelBeliefModel()
+        self.scheme = inference.get("kernel")
+        self.rng = np.random.default_rng(seed)
+        self.speeds = speeds
+        self.reset()
+
+    def reset(self, target=None, start=None) -> None:
+        self.voxels = VoxelMap(memory=self.config.scan_memory)
+        self.beliefs = None
+        self.d_start = None
+        if target is not None and start is not None:
+            self.d_start = float(np.linalg.norm(np.asarray(target, float) - np.asarray(start, float)))
+
+    def observe(self, scan, position=None) -> None:
+        self.voxels.add(scan.points)
+
+    def sense(self, position) -> tuple[np.ndarray, float, float, float]:
+        """(nearby voxels, d_obs, rho, S) at ``position``."""
+        V = self.voxels.near(position)
+        d_obs = clearance(position, V)
+        rho = density(position, V)
+        return V, d_obs, rho, float(suitability(d_obs, rho))
+
+    def decide(self, position, target) -> Decision:
+        pos = np.asarray(position, float)
+        tgt = np.asarray(target, float)
+        if self.d_start is None:
+            self.d_start = float(np.linalg.norm(tgt - pos))
+        V, d_obs, rho, S = self.sense(pos)
+        # the planning call, timed as the original's server round trip: beliefs, candidates,
+        # per-waypoint suitability, filter, EFE, ranking (perception ran on the client before)
+        t0 = time.perf_counter()
+        # moveToPositionAsync keeps the take-off yaw, so the egocentric frame is the world frame
+        obs = {**egocentric_state(pos, tgt, 0.0), "suitability": S, "density": min(rho, 1.0)}
+        prior = self.beliefs if self.config.persistent_beliefs else None
+        beliefs, _ = self.scheme(self.model, prior, [obs])
+        self.beliefs = beliefs
+        H = [entropy(b) for b in beliefs]
+        if self.config.depth > 1:
+            plan, _ = plan_sequence(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
+                                    self.config.planner, LookaheadConfig(depth=self.config.depth))
+        else:
+            plan = plan_waypoints(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
+                                  self.config.planner)
+        plan_ms = 1e3 * (time.perf_counter() - t0)
+        d_tgt = float(np.linalg.norm(tgt - pos))
+        slow = d_tgt < self.config.near_goal or rho > self.config.dense
+        expected = expected_state(self.model, beliefs)
+        scale = 1.0 - 0.5 * (normalised_entropy(self.model, beliefs, "distance")
+                             + normalised_entropy(self.model, beliefs, "azimuth"))
+        state = {"d_obs": d_obs, "rho": rho, "S": S, "expected_distance": expected["distance"],
+                 "expected_suitability": expected["suitability"] * scale, "entropy_sum": H[0] + H[1] + H[2]}
+        return Decision(plan.actions[0], self.speeds[1] if slow else self.speeds[0], plan, plan_ms, state)

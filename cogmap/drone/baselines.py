@@ -1,0 +1,74 @@
+"""Drone baselines: straight-line flight and a potential field over the sensed voxels."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .agent import Decision, VoxelMap
+
+
+@dataclass
+class _Plan:
+    rule: str = "baseline"
+    efe_us_per_candidate: float = float("nan")
+
+
+class StraightLine:
+    """Fly toward the target in steps of ``step`` metres, blind to obstacles."""
+
+    replans_in_flight = False
+
+    def __init__(self, step: float = 3.0, speeds=(2.0, 1.5)):
+        self.step, self.speeds = step, speeds
+
+    def reset(self, target=None, start=None) -> None:
+        pass
+
+    def observe(self, scan, position=None) -> None:
+        pass
+
+    def decide(self, position, target) -> Decision:
+        pos, tgt = np.asarray(position, float), np.asarray(target, float)
+        d = tgt - pos
+        n = float(np.linalg.norm(d))
+        wp = tgt.copy() if n <= self.step else pos + self.step * d / n
+        return Decision(wp, self.speeds[1] if n < 10 else self.speeds[0], _Plan("straight"), 0.0, {})
+
+
+class PotentialField:
+    """Attraction to the target plus repulsion from voxels within ``influence`` metres
+    (k_rep (1/d - 1/influence) / d^2 along the away direction); one step of ``step`` metres along
+    the resulting force; a floor keeps it above ``min_altitude``."""
+
+    replans_in_flight = False
+
+    def __init__(self, step: float = 2.0, influence: float = 5.0, k_att: float = 1.0, k_rep: float = 4.0,
+                 min_altitude: float = 1.0, speeds=(2.0, 1.5)):
+        self.step, self.influence, self.k_att, self.k_rep = step, influence, k_att, k_rep
+        self.min_altitude, self.speeds = min_altitude, speeds
+        self.voxels = VoxelMap()
+
+    def reset(self, target=None, start=None) -> None:
+        self.voxels = VoxelMap()
+
+    def observe(self, scan, position=None) -> None:
+        self.voxels.add(scan.points)
+
+    def decide(self, position, target) -> Decision:
+        pos, tgt = np.asarray(position, float), np.asarray(target, float)
+        d = tgt - pos
+        n = float(np.linalg.norm(d))
+        force = self.k_att * d / max(n, 1e-9)
+        V = self.voxels.near(pos, self.influence)
+        if len(V):
+            away = pos - V
+            dist = np.maximum(np.linalg.norm(away, axis=1), 0.05)
+            mag = self.k_rep * (1.0 / dist - 1.0 / self.influence) / dist ** 2
+            force = force + (mag[:, None] * away / dist[:, None]).sum(0)
+        f = float(np.linalg.norm(force))
+        step = min(self.step, n)
+        wp = pos + step * force / max(f, 1e-9)
+        wp[2] = max(wp[2], self.min_altitude)
+        return Decision(wp, self.speeds[1] if n < 10 else self.speeds[0], _Plan("potential"), 0.0, {})
