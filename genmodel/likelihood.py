@@ -9,7 +9,6 @@ single-factor modalities the planning statistics ``column_stats`` and ``mixture`
 :class:`DenseLikelihood` stores ``A[o, s_1, ..., s_k]`` at capacity (pymdp layout).
 
 :class:`SparseLikelihood`, for a modality over one growable factor, stores counts only:
-
 column ``s`` of ``A`` is the mean of a Dirichlet whose counts are a *symmetric prior* of total
 concentration ``prior[s]`` spread evenly over the live outcomes, plus *learned counts* on the
 few outcomes that were ever observed at ``s``::
