@@ -23,6 +23,9 @@ from .textures import (
 FLOOR_RGBA = (0.55, 0.55, 0.5, 1.0)
 
 
+EYE_OFFSET = (3.7e-7, -2.9e-7, 1.3e-7)  # metres; see PyBulletScene.view
+
+
 def _quat(yaw: float):
     return (0.0, 0.0, float(np.sin(yaw / 2)), float(np.cos(yaw / 2)))
 
@@ -152,8 +155,11 @@ class PyBulletScene:
         key = (width, height, fov_deg)
         if key not in self._proj:
             self._proj[key] = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 30.0)
-        eye = [float(eye_xy[0]), float(eye_xy[1]), z]
-        tgt = [eye[0] + np.cos(heading), eye[1] + np.sin(heading), z]
+        # pybullet's TinyRenderer never returns when the eye lies exactly in the plane of a box
+        # face (walls sit on round coordinates, and so do moves on a 1 m lattice): a sub-micron
+        # offset, far below a pixel, keeps the eye off every such plane
+        eye = [float(eye_xy[0]) + EYE_OFFSET[0], float(eye_xy[1]) + EYE_OFFSET[1], z + EYE_OFFSET[2]]
+        tgt = [eye[0] + np.cos(heading), eye[1] + np.sin(heading), eye[2]]
         vm = p.computeViewMatrix(eye, tgt, [0, 0, 1])
         _, _, rgba, _, _ = p.getCameraImage(width, height, vm, self._proj[key],
                                             renderer=p.ER_TINY_RENDERER, shadow=0,
