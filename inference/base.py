@@ -205,6 +205,29 @@ def pose_evidence(model, pose, t: int = 0) -> Evidence | None:
     return Evidence((pm.factor,), np.exp(logk - top), top, POSE_KEY)
 
 
+def _controls(a, t: int) -> tuple[int, ...]:
+    """One time step's controls as ints; floats, strings and bools are refused, never truncated
+    or parsed."""
+    if isinstance(a, str | bytes):
+        raise InferenceError(f"actions[{t}]: got the string {a!r}, expected integer control indices")
+    try:
+        arr = np.asarray(a)
+    except (TypeError, ValueError):
+        raise InferenceError(f"actions[{t}]: expected integer control indices, got {a!r}") from None
+    if arr.dtype.kind not in "iu":
+        raise InferenceError(f"actions[{t}]: expected integer control indices, got {a!r} ({arr.dtype.name})")
+    return tuple(int(x) for x in arr.ravel())
+
+
+def check_num_iter(num_iter, scheme: str) -> int:
+    """``num_iter`` must be an integer >= 1 (zero sweeps would return the prior unchanged)."""
+    if isinstance(num_iter, bool | np.bool_) or not isinstance(num_iter, int | np.integer):
+        raise InferenceError(f"{scheme}: num_iter must be an integer >= 1, got {num_iter!r}")
+    if num_iter < 1:
+        raise InferenceError(f"{scheme}: num_iter must be >= 1, got {num_iter}")
+    return int(num_iter)
+
+
 def _check_actions(model, actions, T: int) -> tuple[tuple[int, ...], ...]:
     F = len(model.factors)
     U = model.num_controls
@@ -220,7 +243,7 @@ def _check_actions(model, actions, T: int) -> tuple[tuple[int, ...], ...]:
     for t, a in enumerate(actions):
         if isinstance(a, int | np.integer):
             a = (a,)
-        a = tuple(int(x) for x in np.ravel(np.asarray(a)))
+        a = _controls(a, t)
         if len(a) != F:
             raise InferenceError(f"actions[{t}]: has {len(a)} controls, the model has {F} factor(s)")
         for f, u in enumerate(a):
