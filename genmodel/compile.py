@@ -284,8 +284,10 @@ def compile(spec: ModelSpec, prior_count: float = 1.0, max_entries: int = MAX_EN
 def _check_sizes(spec: ModelSpec, factors, cap_f, cap_m, max_entries: int) -> None:
     """Refuse capacities whose arrays would exceed ``max_entries`` entries, before allocating."""
     for mod in spec.modalities:
-        if isinstance(spec.A[mod.name], SparseA):
-            continue  # stored per state (capacity x slots), bounded with the factor below
+        check_entries((cap_m[mod.name],), f"C['{mod.name}']", "lower the modality's capacity", max_entries)
+        if isinstance(spec.A[mod.name], SparseA):  # stored per state: (capacity, slots)
+            check_entries((cap_f[mod.depends_on[0]], 4), f"A['{mod.name}']", "or fewer states", max_entries)
+            continue
         shape = (cap_m[mod.name],) + tuple(cap_f[d] for d in mod.depends_on)
         check_entries(shape, f"A['{mod.name}']", "or give a SparseA for a modality over one growable factor",
                       max_entries)

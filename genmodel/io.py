@@ -253,6 +253,7 @@ def _layout(meta: dict, max_entries: int) -> dict:
     sparse = meta["sparse"]
     sparse_A = meta.get("sparse_A", [False] * M)
     for m, mod in enumerate(modalities):
+        check_entries((ocaps[m],), f"C['{mod.name}']", "lower the modality's capacity", max_entries)
         if not sparse_A[m]:
             shape = (ocaps[m],) + tuple(caps[names.index(d)] for d in mod.depends_on)
             check_entries(shape, f"A['{mod.name}']", "or give a SparseA", max_entries)

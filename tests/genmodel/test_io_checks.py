@@ -8,7 +8,7 @@ import os
 import numpy as np
 import pytest
 
-from cogmap.genmodel import Factor, Modality, ModelSpec, compile
+from cogmap.genmodel import Factor, Modality, ModelSpec, SpecError, compile
 from cogmap.genmodel.io import ModelFileError, json_digest, load, save, write_files
 
 from .test_io import grown_model, sparse_model
@@ -117,3 +117,17 @@ def test_directory_or_device_in_place_of_a_file_is_refused(tmp_path):
     os.symlink("/dev/zero", npz)
     with pytest.raises(ModelFileError, match=r"m\.npz: not a regular file \(a device, pipe or socket\)"):
         load(tmp_path / "m")
+
+
+def test_huge_outcome_capacity_of_a_sparse_modality_is_bounded(tmp_path):
+    from cogmap.genmodel import SparseA
+
+    spec = ModelSpec([Factor("s", 2, growable=True)], [Modality("o", 2, ("s",), growable=True)],
+                     A={"o": SparseA(prior=np.ones(2))}, B={"s": np.eye(2)[..., None]})
+    path = forge(tmp_path, compile(spec), meta_edit=lambda m: m.update(obs_capacities=[10**12]))
+    with pytest.raises(ModelFileError, match=r"C\['o'\]: capacity shape \(1000000000000,\)"):
+        load(path)
+    big = ModelSpec([Factor("s", 2, growable=True)], [Modality("o", 2, ("s",), growable=True, capacity=10**12)],
+                    A={"o": SparseA(prior=np.ones(2))}, B={"s": np.eye(2)[..., None]})
+    with pytest.raises(SpecError, match=r"C\['o'\]: capacity shape"):
+        compile(big)
