@@ -19,8 +19,9 @@ Every scheme has the call
   evidence). The metric pose contributes the likelihood ``exp(-|p - poses[s]|^2 / (2 sigma^2))``
   over the live states of the pose factor (the Gaussian's constant ``2 pi sigma^2`` is left
   out, so free energies with pose evidence are defined up to that constant).
-* ``actions``: ``T - 1`` control tuples (one control per factor; a bare int is accepted for a
-  single factor). May be omitted when every factor has a single control.
+* ``actions``: ``T - 1`` control tuples (one integer control per factor; a bare int is accepted
+  for a single factor; floats, strings and bools are refused). May be omitted when every factor
+  has a single control.
 
 ``posterior`` is the per-factor list of beliefs (live length) at the last step and ``info`` an
 :class:`InferenceInfo`.
