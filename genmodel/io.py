@@ -55,7 +55,7 @@ def _sha256_file(path: Path) -> str:
 def json_digest(meta: dict) -> str:
     """SHA-256 of the description without its own digest (canonical JSON: sorted keys)."""
     body = {k: v for k, v in meta.items() if k != "json_sha256"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True, allow_nan=False).encode()).hexdigest()
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
 
 
 def write_files(npz_path: Path, json_path: Path, arrays: dict[str, np.ndarray], meta: dict) -> None:
@@ -66,7 +66,7 @@ def write_files(npz_path: Path, json_path: Path, arrays: dict[str, np.ndarray], 
     meta["npz_sha256"] = _sha256_file(npz_path)
     meta["arrays"] = sorted(arrays)
     meta["json_sha256"] = json_digest(meta)
-    json_path.write_text(json.dumps(meta, indent=1, allow_nan=False))
+    json_path.write_text(json.dumps(meta, indent=1))
 
 
 def save(model: Model, path) -> tuple[Path, Path]:

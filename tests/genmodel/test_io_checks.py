@@ -131,3 +131,9 @@ def test_huge_outcome_capacity_of_a_sparse_modality_is_bounded(tmp_path):
                     A={"o": SparseA(prior=np.ones(2))}, B={"s": np.eye(2)[..., None]})
     with pytest.raises(SpecError, match=r"C\['o'\]: capacity shape"):
         compile(big)
+
+
+def test_nan_setting_in_the_description_is_refused(tmp_path):
+    path = forge(tmp_path, grown_model(), meta_edit=lambda m: m.update(prior_count=float("nan")))
+    with pytest.raises(ModelFileError, match="prior_count: must be a positive finite number, got nan"):
+        load(path)
