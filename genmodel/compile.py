@@ -168,6 +168,16 @@ def compile(spec: ModelSpec, prior_count: float = 1.0, max_entries: int = MAX_EN
             or not np.isfinite(prior_count) or prior_count <= 0:
         raise SpecError(f"prior_count: must be a positive finite number, got {prior_count!r}")
     factors, modalities = _validate_names(spec)
+    try:
+        return _compile(spec, factors, prior_count, max_entries)
+    except MemoryError:
+        raise SpecError(
+            "not enough memory for the arrays at the declared capacities (lower the capacities, or give "
+            "SparseA/SparseB for large growable factors)"
+        ) from None
+
+
+def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, max_entries: int) -> Model:
     order_f = [f.name for f in spec.factors]
     cap_f = {f.name: _capacity(f.size, f.growable, f.capacity, f"factor '{f.name}'") for f in spec.factors}
     cap_m = {

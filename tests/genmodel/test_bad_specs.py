@@ -65,3 +65,14 @@ def test_sparse_transitions_at_a_large_capacity_are_accepted():
     s.A = {"o": SparseA(prior=np.ones(2))}
     model = compile(s)
     assert model.state_capacity(0) == 10**6
+
+
+def test_running_out_of_memory_under_the_limit_is_a_spec_error(monkeypatch):
+    import cogmap.genmodel.compile as comp
+
+    def no_memory(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(comp, "_fill_dead_columns", no_memory)  # as if the dense A could not be allocated
+    with pytest.raises(SpecError, match="not enough memory .* SparseA/SparseB"):
+        compile(spec())
