@@ -35,6 +35,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from cogmap.genmodel.compile import real_array
+
 POSE_KEY = "pose"
 ATOL = 1e-6
 #: floor used inside logarithms by the variational schemes (the same floor as pymdp 1.0)
@@ -94,10 +96,7 @@ class Problem:
 
 # -- checking --------------------------------------------------------------------------------
 def _check_distribution(x, n_live: int, cap: int, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InferenceError(f"{what}: not a numeric vector") from None
+    arr = real_array(x, what, InferenceError)  # refuses complex, strings, ragged nesting
     if arr.ndim != 1 or arr.shape[0] not in (n_live, cap):
         raise InferenceError(
             f"{what}: expected a vector of length {n_live} (live) or {cap} (capacity), "
@@ -192,10 +191,7 @@ def pose_evidence(model, pose, t: int = 0) -> Evidence | None:
     if pose is None:
         return None
     pm = model.pose
-    try:
-        p = np.asarray(pose, dtype=float)
-    except (TypeError, ValueError):
-        raise InferenceError(f"observations[{t}] pose: not numeric") from None
+    p = real_array(pose, f"observations[{t}] pose", InferenceError)
     if p.shape != (2,) or not np.all(np.isfinite(p)):
         raise InferenceError(f"observations[{t}] pose: expected finite (x, y), got {pose!r}")
     n = model.num_states[pm.factor]

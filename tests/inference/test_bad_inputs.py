@@ -42,3 +42,11 @@ def test_num_iter_below_one_or_not_an_integer_is_refused(model, name, num_iter, 
     with pytest.raises(InferenceError) as err:
         inference.get(name)(model, [model.live_D(0)], [0], num_iter=num_iter)
     assert message in str(err.value)
+
+
+def test_complex_or_string_prior_and_evidence_are_refused(model):
+    exact = inference.get("exact")
+    with pytest.raises(InferenceError, match="prior for factor 's': complex entries"):
+        exact(model, [np.array([0.5, 0.5]) + 0j], [0])
+    with pytest.raises(InferenceError, match=r"observations\[0\] for modality 'o': not a numeric array \(got strings"):
+        exact(model, [model.live_D(0)], [[["0.5", "0.5"]]])
