@@ -124,6 +124,8 @@ CASES = [
     ("inference", "action out of range", _infer(actions=(5,))),
     ("inference", "num_iter=0", _infer("fpi", actions=(), num_iter=0)),
     ("inference", "num_iter negative", _infer("vmp", actions=(), num_iter=-2)),
+    ("inference", "complex prior", lambda d: inference.get("exact")(_model(), [np.array([0.5, 0.5]) + 0j], [0])),
+    ("inference", "prior not normalised", lambda d: inference.get("exact")(_model(), [np.array([0.5, 0.6])], [0])),
     ("inference", "observation index out of range", lambda d: inference.get("exact")(_model(), [_model().live_D(0)],
                                                                                      [7])),
     ("load", "description edited by hand", _forge(edit_json_only=lambda m: m.update(prior_count=5.0))),
