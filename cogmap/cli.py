@@ -1,5 +1,9 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap drone fly``, ``cogmap reproduce``."""
+``cogmap drone fly``, ``cogmap reproduce``.
+
+Every error ends the command with one line on stderr naming the problem and exit status 2
+(``--debug`` shows the traceback instead); ``cogmap --version`` prints the version.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +11,9 @@ import argparse
 import json
 import sys
 from pathlib import Path
+
+from . import __version__
+from .argtypes import OneLineParser, nonnegative_int, positive_int
 
 
 def _explore(args) -> int:
@@ -36,14 +43,7 @@ def _compare(args) -> int:
 
     from .compare import compare_inference, format_table, generate_sequence, load_model
 
-    if args.steps < 1:
-        print(f"cogmap compare-inference: --steps must be at least 1, got {args.steps}", file=sys.stderr)
-        return 2
-    try:
-        model = load_model(args.model, np.random.default_rng(args.seed))
-    except (ValueError, ImportError, AttributeError, TypeError, OSError) as err:
-        print(f"cogmap compare-inference: {err}", file=sys.stderr)
-        return 2
+    model = load_model(args.model, np.random.default_rng(args.seed))
     seq = generate_sequence(model, T=args.steps, seed=args.seed)
     rows = compare_inference(model, seq.observations, seq.actions, true_states=seq.states)
     print(format_table(rows))
@@ -69,13 +69,15 @@ def _reproduce(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="cogmap", description="Active-inference navigation toolkit")
+    p = OneLineParser(prog="cogmap", description="Active-inference navigation toolkit")
+    p.add_argument("--version", action="version", version=f"cogmap {__version__}")
+    p.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     sub = p.add_subparsers(dest="command", required=True)
 
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
     e.add_argument("--env", default="mini_warehouse", help="layout name or registered id (default: mini_warehouse)")
-    e.add_argument("--steps", type=int, default=150, help="at most this many decisions (default: 150)")
-    e.add_argument("--patience", type=int, default=20,
+    e.add_argument("--steps", type=positive_int, default=150, help="at most this many decisions (default: 150)")
+    e.add_argument("--patience", type=nonnegative_int, default=20,
                    help="end once the map has not grown and no state was visited for the first time in this "
                         "many decisions (default: 20; 0: always run --steps)")
     e.add_argument("--seed", type=int, default=0)
@@ -92,8 +94,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--run", required=True, help="directory written by 'cogmap explore'")
     src = g.add_mutually_exclusive_group(required=True)
     src.add_argument("--goal-image", help="PNG of the goal panorama")
-    src.add_argument("--goal-obs", type=int, help="id of a stored observation (observations/NNNN.png)")
-    g.add_argument("--steps", type=int, default=60)
+    src.add_argument("--goal-obs", type=nonnegative_int, help="id of a stored observation (observations/NNNN.png)")
+    g.add_argument("--steps", type=positive_int, default=60)
     g.add_argument("--seed", type=int, default=0)
     g.add_argument("--out", default=None, help="directory for the goal run (default: <run>/goal)")
     g.add_argument("--quiet", action="store_true")
@@ -103,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--model", default="tmaze",
                    help="a built-in model (tmaze, corridor, random), a saved model (PATH of its .npz/.json) "
                         "or a factory (module:function returning a compiled Model)")
-    c.add_argument("--steps", type=int, default=30)
+    c.add_argument("--steps", type=positive_int, default=30)
     c.add_argument("--seed", type=int, default=0)
     c.set_defaults(func=_compare)
 
@@ -113,11 +115,12 @@ def build_parser() -> argparse.ArgumentParser:
     dsub = d.add_subparsers(dest="drone_command", required=True)
     f = dsub.add_parser("fly", help="fly seeded episodes and write a run directory")
     f.add_argument("--seed", type=int, default=0, help="field seed; episode i's target is drawn from (seed, i)")
-    f.add_argument("--episodes", type=int, default=1)
-    f.add_argument("--first-episode", type=int, default=0, help="index of the first episode (default: 0)")
+    f.add_argument("--episodes", type=positive_int, default=1)
+    f.add_argument("--first-episode", type=nonnegative_int, default=0, help="index of the first episode (default: 0)")
     f.add_argument("--method", default="agent", choices=DRONE_METHODS)
     f.add_argument("--end-on-collision", action="store_true", help="a collision ends the episode (the honest setting)")
-    f.add_argument("--pictures", type=int, default=3, help="top/side PNGs of the first N episodes (default: 3)")
+    f.add_argument("--pictures", type=nonnegative_int, default=3,
+                   help="top/side PNGs of the first N episodes (default: 3)")
     f.add_argument("--out", default=None, help="run directory (default: print the summary only)")
     f.add_argument("--quiet", action="store_true")
     f.set_defaults(func=_drone_fly)
@@ -130,9 +133,31 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def one_line(err: BaseException) -> str:
+    """An error as one line: its message (its type too when the message alone is unclear)."""
+    text = " ".join(str(err).split())
+    if isinstance(err, OSError) and err.filename is not None and err.strerror:
+        return f"{err.filename}: {err.strerror}"
+    if isinstance(err, ValueError | RuntimeError | OSError) and text:
+        return text
+    return f"{type(err).__name__}: {text}" if text else type(err).__name__
+
+
 def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
-    return args.func(args)
+    prog = f"cogmap {args.command}" + (f" {args.drone_command}" if args.command == "drone" else "")
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        if args.debug:
+            raise
+        print(f"{prog}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as err:  # noqa: BLE001 - every error becomes one line unless --debug
+        if args.debug:
+            raise
+        print(f"{prog}: error: {one_line(err)}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

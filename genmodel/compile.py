@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from .likelihood import DenseLikelihood, SparseLikelihood
@@ -10,13 +12,28 @@ from .spec import Factor, Modality, ModelSpec, SparseA, SparseB, SpecError
 from .transitions import DenseTransitions, SparseTransitions
 
 ATOL = 1e-6
+#: largest number of entries of one array a compiled model may reserve (dense A or B at capacity,
+#: a sparse factor's successor lists); above it ``compile`` refuses before allocating anything.
+MAX_ENTRIES = 2**31
+
+
+def real_array(value, what: str, error=SpecError) -> np.ndarray:
+    """``value`` as a float array; refuses ragged nesting, strings, objects and complex numbers
+    (which a plain ``float`` cast would truncate or parse)."""
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        raise error(f"{what}: not a numeric array (nested lists of unequal lengths or mixed types)") from None
+    if arr.dtype.kind == "c":
+        raise error(f"{what}: complex entries (expected real numbers)")
+    if arr.dtype.kind not in "biuf":
+        kind = {"U": "strings", "S": "bytes", "O": "objects"}.get(arr.dtype.kind, arr.dtype.name)
+        raise error(f"{what}: not a numeric array (got {kind})")
+    return arr.astype(float)
 
 
 def _array(value, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise SpecError(f"{what}: not a numeric array ({err})") from None
+    arr = real_array(value, what)
     if not np.all(np.isfinite(arr)):
         raise SpecError(f"{what}: contains NaN or infinite entries")
     if np.any(arr < 0):
@@ -40,7 +57,30 @@ def _check_name(name: str, known: dict, kind: str, where: str) -> None:
         raise SpecError(f"{where}: unknown {kind} '{name}' (known: {sorted(known)})")
 
 
+def _count(value, what: str, minimum: int = 1) -> int:
+    """An integer size or count (an int, not a bool, float or string) of at least ``minimum``."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, int | np.integer):
+        raise SpecError(f"{what}: must be an integer, got {type(value).__name__} {value!r}")
+    if value < minimum:
+        raise SpecError(f"{what}: must be >= {minimum}, got {value}")
+    return int(value)
+
+
+def check_entries(shape: tuple[int, ...], what: str, hint: str, max_entries: int = MAX_ENTRIES) -> None:
+    """Refuse an array of ``shape`` with more than ``max_entries`` entries, before allocating it."""
+    total = 1
+    for n in shape:
+        total *= int(n)
+    if total > max_entries:
+        raise SpecError(
+            f"{what}: capacity shape {tuple(int(n) for n in shape)} needs {total:.3g} entries, above the limit "
+            f"{max_entries:.3g} (lower the capacity, {hint}, or raise max_entries)"
+        )
+
+
 def _capacity(size: int, growable: bool, capacity: int | None, what: str) -> int:
+    if capacity is not None:
+        capacity = _count(capacity, f"{what} capacity")
     if capacity is None:
         return max(size, 1 << max(0, (size - 1)).bit_length()) if growable else size
     if capacity < size:
@@ -49,14 +89,28 @@ def _capacity(size: int, growable: bool, capacity: int | None, what: str) -> int
 
 
 def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modality]]:
+    for table in ("factors", "modalities"):
+        if isinstance(getattr(spec, table), str | bytes | Mapping) or not hasattr(getattr(spec, table), "__iter__"):
+            raise SpecError(f"{table}: expected a list of {table[:-1].capitalize()} instances")
+    if not spec.factors:
+        raise SpecError("factors: empty (a model needs at least one hidden-state factor)")
+    if not spec.modalities:
+        raise SpecError("modalities: empty (a model needs at least one observation modality)")
+    for table in ("A", "B", "C", "D", "pA", "pB", "C_states"):
+        if not isinstance(getattr(spec, table), Mapping):
+            raise SpecError(f"{table}: expected a dict keyed by name, got {type(getattr(spec, table)).__name__}")
     factors: dict[str, Factor] = {}
     for f in spec.factors:
         if not isinstance(f, Factor):
             raise SpecError(f"factors must be Factor instances, got {type(f).__name__}")
+        if not isinstance(f.name, str) or not f.name:
+            raise SpecError(f"factor {f.name!r}: the name must be a non-empty string")
         if f.name in factors:
             raise SpecError(f"factor '{f.name}': declared twice")
-        if f.size < 1 or f.num_controls < 1:
-            raise SpecError(f"factor '{f.name}': size and num_controls must be >= 1")
+        _count(f.size, f"factor '{f.name}' size")
+        _count(f.num_controls, f"factor '{f.name}' num_controls")
+        if f.stay is not None:
+            _count(f.stay, f"factor '{f.name}' stay", minimum=0)
         if f.stay is not None and not 0 <= f.stay < f.num_controls:
             raise SpecError(f"factor '{f.name}': stay control {f.stay} out of range")
         factors[f.name] = f
@@ -64,12 +118,18 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
     for m in spec.modalities:
         if not isinstance(m, Modality):
             raise SpecError(f"modalities must be Modality instances, got {type(m).__name__}")
+        if not isinstance(m.name, str) or not m.name:
+            raise SpecError(f"modality {m.name!r}: the name must be a non-empty string")
         if m.name in modalities:
             raise SpecError(f"modality '{m.name}': declared twice")
-        if m.size < 1:
-            raise SpecError(f"modality '{m.name}': size must be >= 1")
+        _count(m.size, f"modality '{m.name}' size")
+        if isinstance(m.depends_on, str) or not isinstance(m.depends_on, tuple | list):
+            raise SpecError(f"modality '{m.name}': depends_on must be a tuple of factor names, got {m.depends_on!r}")
         if not m.depends_on:
             raise SpecError(f"modality '{m.name}': depends on no factor")
+        twice = sorted({d for d in m.depends_on if list(m.depends_on).count(d) > 1})
+        if twice:
+            raise SpecError(f"modality '{m.name}': depends on factor '{twice[0]}' twice (list each factor once)")
         for dep in m.depends_on:
             if dep not in factors:
                 raise SpecError(
@@ -97,18 +157,34 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
     return factors, modalities
 
 
-def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 - public API name
+def compile(spec: ModelSpec, prior_count: float = 1.0, max_entries: int = MAX_ENTRIES) -> Model:  # noqa: A001
     """Validate ``spec`` and return a :class:`Model`; raises :class:`SpecError` naming the
-    factor or modality and the problem."""
+    factor or modality and the problem.
+
+    ``max_entries`` bounds the entries of any one reserved array (checked before allocating)."""
     if not isinstance(spec, ModelSpec):
         raise SpecError(f"compile() expects a ModelSpec, got {type(spec).__name__}")
+    if isinstance(prior_count, bool) or not isinstance(prior_count, int | float | np.integer | np.floating) \
+            or not np.isfinite(prior_count) or prior_count <= 0:
+        raise SpecError(f"prior_count: must be a positive finite number, got {prior_count!r}")
     factors, modalities = _validate_names(spec)
+    try:
+        return _compile(spec, factors, prior_count, max_entries)
+    except MemoryError:
+        raise SpecError(
+            "not enough memory for the arrays at the declared capacities (lower the capacities, or give "
+            "SparseA/SparseB for large growable factors)"
+        ) from None
+
+
+def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, max_entries: int) -> Model:
     order_f = [f.name for f in spec.factors]
     cap_f = {f.name: _capacity(f.size, f.growable, f.capacity, f"factor '{f.name}'") for f in spec.factors}
     cap_m = {
         m.name: _capacity(m.size, m.growable, m.capacity, f"modality '{m.name}'")
         for m in spec.modalities
     }
+    _check_sizes(spec, factors, cap_f, cap_m, max_entries)
 
     A, C, A_deps = [], [], []
     for mod in spec.modalities:
@@ -186,7 +262,7 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
         D.append(d)
         cs = np.zeros(cap)
         if fac.name in spec.C_states:
-            cv = np.asarray(spec.C_states[fac.name], dtype=float)
+            cv = real_array(spec.C_states[fac.name], f"C_states['{fac.name}']")
             if cv.shape != (n,) or not np.all(np.isfinite(cv)):
                 raise SpecError(f"C_states['{fac.name}']: expected ({n},) finite values")
             cs[:n] = cv
@@ -215,10 +291,30 @@ def compile(spec: ModelSpec, prior_count: float = 1.0) -> Model:  # noqa: A001 -
     )
 
 
+def _check_sizes(spec: ModelSpec, factors, cap_f, cap_m, max_entries: int) -> None:
+    """Refuse capacities whose arrays would exceed ``max_entries`` entries, before allocating."""
+    for mod in spec.modalities:
+        check_entries((cap_m[mod.name],), f"C['{mod.name}']", "lower the modality's capacity", max_entries)
+        if isinstance(spec.A[mod.name], SparseA):  # stored per state: (capacity, slots)
+            check_entries((cap_f[mod.depends_on[0]], 4), f"A['{mod.name}']", "or fewer states", max_entries)
+            continue
+        shape = (cap_m[mod.name],) + tuple(cap_f[d] for d in mod.depends_on)
+        check_entries(shape, f"A['{mod.name}']", "or give a SparseA for a modality over one growable factor",
+                      max_entries)
+    for fac in spec.factors:
+        cap, u = cap_f[fac.name], fac.num_controls
+        raw = spec.B[fac.name]
+        if isinstance(raw, SparseB):
+            slots = np.shape(raw.succ)[2] if len(np.shape(raw.succ)) == 3 else 1
+            check_entries((cap, u, slots), f"B['{fac.name}']", "or fewer successor slots", max_entries)
+        else:
+            check_entries((cap, cap, u), f"B['{fac.name}']", "or give a SparseB (successor lists)", max_entries)
+
+
 def _preferences(spec: ModelSpec, mod: Modality, cap: int) -> np.ndarray:
     c = np.zeros(cap)
     if mod.name in spec.C:
-        cv = np.asarray(spec.C[mod.name], dtype=float)
+        cv = real_array(spec.C[mod.name], f"C['{mod.name}']")
         if cv.shape != (mod.size,):
             raise SpecError(f"C['{mod.name}']: shape {cv.shape}, expected ({mod.size},)")
         if not np.all(np.isfinite(cv)):
@@ -239,7 +335,7 @@ def _sparse_A_from_spec(spec: ModelSpec, mod: Modality, factors, cap_shape) -> S
     if prior.shape != (n,):
         raise SpecError(f"{what}.prior: shape {prior.shape}, expected ({n},) (one concentration per state)")
     o_idx, s_idx = np.asarray(raw.outcomes).ravel(), np.asarray(raw.states).ravel()
-    counts = np.asarray(raw.counts, dtype=float).ravel()
+    counts = real_array(raw.counts, f"{what}.counts").ravel()
     if not (o_idx.size == s_idx.size == counts.size):
         raise SpecError(f"{what}: outcomes, states and counts must have the same length")
     if o_idx.size and (not np.issubdtype(o_idx.dtype, np.integer) or not np.issubdtype(s_idx.dtype, np.integer)):
@@ -266,7 +362,10 @@ def _fill_dead_columns(full: np.ndarray, live_shape: tuple[int, ...]) -> None:
 
 def _sparse_from_spec(raw: SparseB, fac: Factor, cap: int, counts) -> SparseTransitions:
     what = f"B['{fac.name}']"
-    succ = np.asarray(raw.succ)
+    try:
+        succ = np.asarray(raw.succ)
+    except (TypeError, ValueError):
+        raise SpecError(f"{what}.succ: not an integer array") from None
     prob = _array(raw.prob, f"{what}.prob")
     n, u = fac.size, fac.num_controls
     if succ.ndim != 3 or succ.shape[:2] != (n, u) or prob.shape != succ.shape:
@@ -302,15 +401,21 @@ def _pose_from_spec(spec: ModelSpec, factors, order_f, cap_f) -> PoseModel | Non
         return None
     _check_name(ps.factor, factors, "factor", "pose")
     fac = factors[ps.factor]
-    poses = np.asarray(ps.poses, dtype=float)
+    poses = real_array(ps.poses, "pose: poses")
     if poses.shape != (fac.size, 2) or not np.all(np.isfinite(poses)):
         raise SpecError(f"pose: poses must be finite with shape ({fac.size}, 2), got {poses.shape}")
-    headings = np.asarray(ps.headings, dtype=float).ravel()
+    headings = real_array(ps.headings, "pose: headings").ravel()
+    if not np.all(np.isfinite(headings)):
+        raise SpecError("pose: headings must be finite")
     n_moves = fac.num_controls - (1 if fac.stay is not None else 0)
     if headings.shape != (n_moves,):
         raise SpecError(f"pose: {n_moves} headings expected (one per non-stay control), got {headings.size}")
-    if ps.step <= 0 or ps.influence_radius <= 0:
-        raise SpecError("pose: step and influence_radius must be positive")
+    for key in ("step", "influence_radius") + (("sigma",) if ps.sigma is not None else ()):
+        v = getattr(ps, key)
+        if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating) or not np.isfinite(v):
+            raise SpecError(f"pose: {key} must be a finite number, got {v!r}")
+    if ps.step <= 0 or ps.influence_radius <= 0 or (ps.sigma is not None and ps.sigma <= 0):
+        raise SpecError("pose: step, influence_radius and sigma must be positive")
     full = np.zeros((cap_f[ps.factor], 2))
     full[: fac.size] = poses
     sigma = ps.sigma if ps.sigma is not None else ps.influence_radius / 2

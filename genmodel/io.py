@@ -1,27 +1,37 @@
 """Save and load models as ``<stem>.npz`` (arrays) + ``<stem>.json`` (structure). No pickle.
 
-The JSON records factors, modalities, live sizes, dependencies, settings and the SHA-256 of the
-npz file, so a truncated, corrupt or mismatched pair is refused with a clear error.
+The JSON records factors, modalities, live sizes, dependencies and settings, the SHA-256 of the
+npz file and (from format version 3) the SHA-256 of its own other content, so a truncated,
+corrupt, edited or mismatched pair is refused with a clear error. :func:`load` bounds every
+size and array before allocating it, reads only regular files, and rebuilds the model through
+:func:`~cogmap.genmodel.compile.compile`, so a loaded model passes every check a compiled one
+does (finite, non-negative, normalised A/B/D, successor indices in range, pose shapes, names).
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+import os
+import stat
 import zipfile
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 
 import numpy as np
 
-from .likelihood import DenseLikelihood, SparseLikelihood
-from .model import Model, PoseModel
-from .spec import Factor, InductiveSpec, Modality, SpecError
-from .transitions import DenseTransitions, SparseTransitions
+from .compile import MAX_ENTRIES, check_entries
+from .compile import compile as compile_spec
+from .model import Model
+from .spec import Factor, InductiveSpec, Modality, ModelSpec, PoseSpec, SparseA, SparseB, SpecError
+from .transitions import SparseTransitions
 
 FORMAT = "cogmap-model"
-VERSION = 2  # 2: sparse likelihoods (SparseA) saved as their counts; version 1 files still load
-READABLE = (1, 2)
+#: 3: the JSON carries the digest of its own content; 2: sparse likelihoods (SparseA) saved as
+#: their counts; version 1 and 2 files still load (without the JSON digest)
+VERSION = 3
+READABLE = (1, 2, 3)
+MAX_JSON_BYTES = 64 * 2**20  # a model description is a few kB; refuse anything absurd before reading
 
 
 class ModelFileError(SpecError):
@@ -34,10 +44,34 @@ def _paths(path) -> tuple[Path, Path]:
     return stem.with_suffix(".npz"), stem.with_suffix(".json")
 
 
+def _sha256_file(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def json_digest(meta: dict) -> str:
+    """SHA-256 of the description without its own digest (canonical JSON: sorted keys)."""
+    body = {k: v for k, v in meta.items() if k != "json_sha256"}
+    return hashlib.sha256(json.dumps(body, sort_keys=True).encode()).hexdigest()
+
+
+def write_files(npz_path: Path, json_path: Path, arrays: dict[str, np.ndarray], meta: dict) -> None:
+    """Write ``arrays`` and ``meta`` with both digests filled in (``meta`` is updated)."""
+    npz_path.parent.mkdir(parents=True, exist_ok=True)
+    with open(npz_path, "wb") as fh:
+        np.savez_compressed(fh, **arrays)
+    meta["npz_sha256"] = _sha256_file(npz_path)
+    meta["arrays"] = sorted(arrays)
+    meta["json_sha256"] = json_digest(meta)
+    json_path.write_text(json.dumps(meta, indent=1))
+
+
 def save(model: Model, path) -> tuple[Path, Path]:
     """Write the model; returns the (npz, json) paths. Arrays are saved at live sizes."""
     npz_path, json_path = _paths(path)
-    npz_path.parent.mkdir(parents=True, exist_ok=True)
     arrays: dict[str, np.ndarray] = {}
     for m in range(len(model.modalities)):
         arrays[f"C{m}"] = model.live_C(m)
@@ -68,8 +102,6 @@ def save(model: Model, path) -> tuple[Path, Path]:
     if model.pose is not None:
         arrays["poses"] = model.pose.poses[: model.num_states[model.pose.factor]]
         arrays["headings"] = model.pose.headings
-    with open(npz_path, "wb") as fh:
-        np.savez_compressed(fh, **arrays)
     meta = {
         "format": FORMAT,
         "version": VERSION,
@@ -93,19 +125,57 @@ def save(model: Model, path) -> tuple[Path, Path]:
             "influence_radius": model.pose.influence_radius,
             "sigma": model.pose.sigma,
         },
-        "npz_sha256": hashlib.sha256(npz_path.read_bytes()).hexdigest(),
-        "arrays": sorted(arrays),
     }
-    json_path.write_text(json.dumps(meta, indent=1))
+    write_files(npz_path, json_path, arrays, meta)
     return npz_path, json_path
 
 
-def load(path) -> Model:
-    """Read a model written by :func:`save`; raises :class:`ModelFileError` on any damage."""
+def _regular_file(p: Path) -> int:
+    """Size of ``p``; refuses anything but an existing regular file (symlinks are followed, so a
+    link to a directory or a device is refused too)."""
+    try:
+        st = os.stat(p)
+    except FileNotFoundError:
+        raise ModelFileError(f"{p}: file not found") from None
+    except OSError as err:
+        raise ModelFileError(f"{p}: cannot be read ({err.strerror})") from None
+    if not stat.S_ISREG(st.st_mode):
+        kind = "a directory" if stat.S_ISDIR(st.st_mode) else "a device, pipe or socket"
+        raise ModelFileError(f"{p}: not a regular file ({kind})")
+    return st.st_size
+
+
+def _read_headers(npz_path: Path, max_entries: int) -> None:
+    """Check every array's declared shape and type in the archive before decompressing any."""
+    try:
+        with zipfile.ZipFile(npz_path) as zf:
+            for info in zf.infolist():
+                with zf.open(info) as fh:
+                    version = np.lib.format.read_magic(fh)
+                    if version == (1, 0):
+                        shape, _, dtype = np.lib.format.read_array_header_1_0(fh)
+                    else:
+                        shape, _, dtype = np.lib.format.read_array_header_2_0(fh)
+                name = info.filename.removesuffix(".npy")
+                if dtype.hasobject or dtype.kind not in "biuf":
+                    raise ModelFileError(f"{npz_path}: array {name} has type {dtype} (expected numbers)")
+                try:
+                    check_entries(shape, f"array {name}", "or check the file", max_entries)
+                except SpecError as err:
+                    raise ModelFileError(f"{npz_path}: {err}") from None
+    except (zipfile.BadZipFile, ValueError, OSError, EOFError) as err:
+        raise ModelFileError(f"{npz_path}: unreadable array archive ({err})") from None
+
+
+def load(path, max_entries: int = MAX_ENTRIES) -> Model:
+    """Read a model written by :func:`save`; raises :class:`ModelFileError` on any damage.
+
+    ``max_entries`` bounds every array (in the file and at the declared capacities) before it
+    is allocated, as in :func:`~cogmap.genmodel.compile.compile`."""
     npz_path, json_path = _paths(path)
-    for p in (npz_path, json_path):
-        if not p.exists():
-            raise ModelFileError(f"{p}: file not found")
+    sizes = {p: _regular_file(p) for p in (npz_path, json_path)}
+    if sizes[json_path] > MAX_JSON_BYTES:
+        raise ModelFileError(f"{json_path}: {sizes[json_path]} bytes, too large for a model description")
     try:
         meta = json.loads(json_path.read_text())
     except (json.JSONDecodeError, UnicodeDecodeError) as err:
@@ -115,9 +185,17 @@ def load(path) -> Model:
     if meta.get("version") not in READABLE:
         raise ModelFileError(f"{json_path}: format version {meta.get('version')} is not supported "
                              f"(this cogmap reads versions {', '.join(map(str, READABLE))})")
-    digest = hashlib.sha256(npz_path.read_bytes()).hexdigest()
-    if digest != meta.get("npz_sha256"):
+    if meta["version"] >= 3 and meta.get("json_sha256") != json_digest(meta):
+        raise ModelFileError(f"{json_path}: edited or corrupt (its content does not match its digest)")
+    if _sha256_file(npz_path) != meta.get("npz_sha256"):
         raise ModelFileError(f"{npz_path}: contents do not match {json_path.name} (truncated or corrupt)")
+    try:
+        layout = _layout(meta, max_entries)
+    except (KeyError, TypeError, IndexError, ValueError, AttributeError) as err:
+        if isinstance(err, SpecError):
+            raise ModelFileError(f"{json_path}: {err}") from None
+        raise ModelFileError(f"{json_path}: inconsistent model description ({type(err).__name__}: {err})") from None
+    _read_headers(npz_path, max_entries)
     try:
         with np.load(npz_path, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
@@ -127,133 +205,120 @@ def load(path) -> Model:
     if missing:
         raise ModelFileError(f"{npz_path}: missing arrays {sorted(missing)}")
     try:
-        return _rebuild(meta, arrays)
+        return _rebuild(meta, layout, arrays, max_entries)
     except ModelFileError:
         raise
+    except SpecError as err:
+        raise ModelFileError(f"{json_path.with_suffix('')}: {err}") from None
     except (KeyError, TypeError, IndexError, ValueError) as err:
-        raise ModelFileError(f"{json_path}: inconsistent model description ({err})") from None
+        raise ModelFileError(f"{json_path}: inconsistent model description ({type(err).__name__}: {err})") from None
 
 
-def _rebuild(meta: dict, arrays: dict[str, np.ndarray]) -> Model:
+def _int_list(meta: dict, key: str, length: int, minimum: int) -> list[int]:
+    v = meta[key]
+    if not isinstance(v, list) or len(v) != length:
+        raise ModelFileError(f"'{key}' must be a list of {length} integers")
+    for x in v:
+        if isinstance(x, bool) or not isinstance(x, int) or x < minimum:
+            raise ModelFileError(f"'{key}' must hold integers >= {minimum}, got {x!r}")
+    return v
+
+
+def _layout(meta: dict, max_entries: int) -> dict:
+    """Factors, modalities, sizes and capacities of the description, checked and bounded
+    before anything is allocated."""
     factors = tuple(
         Factor(**{**f, "control_names": None if f["control_names"] is None else tuple(f["control_names"])})
         for f in meta["factors"]
     )
     modalities = tuple(Modality(**{**m, "depends_on": tuple(m["depends_on"])}) for m in meta["modalities"])
-    ns, no = list(meta["num_states"]), list(meta["num_obs"])
-    caps, ocaps = meta["capacities"], meta["obs_capacities"]
-    deps = tuple(tuple(d) for d in meta["A_deps"])
-    A, C = [], []
-    sparse_A = meta.get("sparse_A", [False] * len(deps))
-    for m, d in enumerate(deps):
-        c = np.zeros(ocaps[m])
-        c[: no[m]] = _check(arrays[f"C{m}"], (no[m],), f"C{m}")
-        C.append(c)
-        if sparse_A[m]:
-            A.append(_sparse_likelihood(arrays, m, no[m], ns[d[0]], caps[d[0]]))
-            continue
-        shape = (ocaps[m],) + tuple(caps[f] for f in d)
-        live = (slice(0, no[m]),) + tuple(slice(0, ns[f]) for f in d)
-        a = np.zeros(shape)
-        a[live] = _check(arrays[f"A{m}"], (no[m],) + tuple(ns[f] for f in d), f"A{m}")
-        if modalities[m].size and a.ndim > 1:
-            dead = np.ones(shape[1:], dtype=bool)
-            dead[live[1:]] = False
-            a[: no[m], dead] = 1.0 / max(1, no[m])
-        p = None
-        if f"pA{m}" in arrays:
-            p = np.zeros(shape)
-            p[live] = _check(arrays[f"pA{m}"], a[live].shape, f"pA{m}")
-        A.append(DenseLikelihood(a, p, no[m], tuple(ns[f] for f in d)))
-    B, D, Cs = [], [], []
+    F, M = len(factors), len(modalities)
+    ns = _int_list(meta, "num_states", F, 1)
+    no = _int_list(meta, "num_obs", M, 1)
+    caps = _int_list(meta, "capacities", F, 1)
+    ocaps = _int_list(meta, "obs_capacities", M, 1)
+    for key, sizes, cap in (("capacities", ns, caps), ("obs_capacities", no, ocaps)):
+        for i, (n, c) in enumerate(zip(sizes, cap, strict=True)):
+            if c < n:
+                raise ModelFileError(f"'{key}'[{i}] = {c} is smaller than the live size {n}")
+    names = [f.name for f in factors]
+    deps = meta["A_deps"]
+    for m, mod in enumerate(modalities):
+        if not isinstance(mod.depends_on, tuple) or any(d not in names for d in mod.depends_on):
+            raise ModelFileError(f"modality '{mod.name}': depends on {list(mod.depends_on)}, "
+                                 f"not all among the factors {names}")
+        if list(deps[m]) != [names.index(d) for d in mod.depends_on]:
+            raise ModelFileError(f"A_deps[{m}] = {deps[m]} does not match modality '{mod.name}' "
+                                 f"depending on {list(mod.depends_on)}")
+    sparse = meta["sparse"]
+    sparse_A = meta.get("sparse_A", [False] * M)
+    for m, mod in enumerate(modalities):
+        check_entries((ocaps[m],), f"C['{mod.name}']", "lower the modality's capacity", max_entries)
+        if not sparse_A[m]:
+            shape = (ocaps[m],) + tuple(caps[names.index(d)] for d in mod.depends_on)
+            check_entries(shape, f"A['{mod.name}']", "or give a SparseA", max_entries)
     for f, fac in enumerate(factors):
-        n, cap, u = ns[f], caps[f], fac.num_controls
-        if meta["sparse"][f]:
-            succ = arrays[f"Bsucc{f}"]
-            k = succ.shape[2]
-            t = SparseTransitions.empty(cap, u, k, with_counts=f"Bcounts{f}" in arrays)
-            t.succ[:n] = _check(succ, (n, u, k), f"Bsucc{f}")
-            t.prob[:n] = _check(arrays[f"Bprob{f}"], (n, u, k), f"Bprob{f}")
-            if t.counts is not None:
-                t.counts[:n] = _check(arrays[f"Bcounts{f}"], (n, u, k), f"Bcounts{f}")
-            B.append(t)
+        if not sparse[f]:
+            check_entries((caps[f], caps[f], fac.num_controls), f"B['{fac.name}']", "or give a SparseB", max_entries)
         else:
-            b = np.zeros((cap, cap, u))
-            b[:n, :n] = _check(arrays[f"B{f}"], (n, n, u), f"B{f}")
-            b[np.arange(n, cap), np.arange(n, cap), :] = 1.0
-            p = None
+            check_entries((caps[f], fac.num_controls), f"B['{fac.name}']", "or fewer states", max_entries)
+    return {"factors": factors, "modalities": modalities, "ns": ns, "no": no, "caps": caps, "ocaps": ocaps,
+            "sparse": sparse, "sparse_A": sparse_A}
+
+
+def _rebuild(meta: dict, layout: dict, arrays: dict[str, np.ndarray], max_entries: int) -> Model:
+    """Turn the arrays back into a :class:`ModelSpec` at the saved live sizes and capacities and
+    compile it (every check of ``compile``), then restore the factors as they were declared."""
+    factors, modalities = layout["factors"], layout["modalities"]
+    ns, no, caps, ocaps = layout["ns"], layout["no"], layout["caps"], layout["ocaps"]
+    spec_factors = [replace(fac, size=ns[f], capacity=caps[f]) for f, fac in enumerate(factors)]
+    spec_mods = [replace(mod, size=no[m], capacity=ocaps[m]) for m, mod in enumerate(modalities)]
+    A, pA, B, pB, C, D, Cs = {}, {}, {}, {}, {}, {}, {}
+    for m, mod in enumerate(modalities):
+        C[mod.name] = arrays[f"C{m}"]
+        if layout["sparse_A"][m]:
+            A[mod.name] = _sparse_A(arrays, m)
+            continue
+        A[mod.name] = arrays[f"A{m}"]
+        if f"pA{m}" in arrays:
+            pA[mod.name] = arrays[f"pA{m}"]
+    for f, fac in enumerate(factors):
+        if layout["sparse"][f]:
+            succ = arrays[f"Bsucc{f}"]
+            if succ.dtype.kind not in "iu":
+                raise ModelFileError(f"array Bsucc{f}: successor indices must be integers, got {succ.dtype}")
+            B[fac.name] = SparseB(succ, arrays[f"Bprob{f}"], arrays.get(f"Bcounts{f}"))
+        else:
+            B[fac.name] = arrays[f"B{f}"]
             if f"pB{f}" in arrays:
-                p = np.zeros((cap, cap, u))
-                p[:n, :n] = _check(arrays[f"pB{f}"], (n, n, u), f"pB{f}")
-            B.append(DenseTransitions(b, p))
-        d = np.zeros(cap)
-        d[:n] = _check(arrays[f"D{f}"], (n,), f"D{f}")
-        D.append(d)
-        cs = np.zeros(cap)
-        cs[:n] = _check(arrays[f"Cs{f}"], (n,), f"Cs{f}")
-        Cs.append(cs)
+                pB[fac.name] = arrays[f"pB{f}"]
+        D[fac.name] = arrays[f"D{f}"]
+        Cs[fac.name] = arrays[f"Cs{f}"]
     pose = None
     if meta["pose"] is not None:
         pm = meta["pose"]
         pf = pm["factor"]
-        poses = np.zeros((caps[pf], 2))
-        poses[: ns[pf]] = _check(arrays["poses"], (ns[pf], 2), "poses")
-        pose = PoseModel(pf, poses, arrays["headings"], pm["step"], pm["influence_radius"], pm["sigma"])
-    model = Model(
-        factors=factors,
-        modalities=modalities,
-        A=A,
-        A_deps=deps,
-        B=B,
-        C=C,
-        D=D,
-        C_states=Cs,
-        num_states=ns,
-        num_obs=no,
-        pose=pose,
-        inductive=None if meta["inductive"] is None else InductiveSpec(**meta["inductive"]),
-        collision_preference=meta["collision_preference"],
-        prior_count=meta["prior_count"],
-    )
-    _check_normalised(model)
+        if isinstance(pf, bool) or not isinstance(pf, int) or not 0 <= pf < len(factors):
+            raise ModelFileError(f"pose: factor index {pf!r} out of range")
+        pose = PoseSpec(factors[pf].name, arrays["poses"], arrays["headings"], pm["step"], pm["influence_radius"],
+                        pm["sigma"])
+    spec = ModelSpec(spec_factors, spec_mods, A=A, B=B, C=C, D=D, pA=pA, pB=pB, C_states=Cs, pose=pose,
+                     inductive=None if meta["inductive"] is None else InductiveSpec(**meta["inductive"]),
+                     collision_preference=meta["collision_preference"])
+    model = compile_spec(spec, prior_count=meta["prior_count"], max_entries=max_entries)
+    model.factors, model.modalities = tuple(factors), tuple(modalities)
     return model
 
 
-def _sparse_likelihood(arrays: dict, m: int, num_obs: int, n: int, cap: int) -> SparseLikelihood:
-    obs = arrays[f"Aobs{m}"]
-    if obs.ndim != 2 or obs.shape[0] != n or obs.dtype.kind not in "iu":
-        raise ModelFileError(f"array Aobs{m}: shape {obs.shape} ({obs.dtype}), expected integers ({n}, slots)")
-    cnt = _check(arrays[f"Acnt{m}"], obs.shape, f"Acnt{m}")
-    prior = _check(arrays[f"Aprior{m}"], (n,), f"Aprior{m}")
-    if obs.size and (obs.min() < -1 or obs.max() >= num_obs):
-        raise ModelFileError(f"array Aobs{m}: outcome index out of range (0..{num_obs - 1}, -1 for free)")
-    if np.any(cnt < 0) or np.any(prior < 0) or np.any((obs < 0) & (cnt != 0)):
-        raise ModelFileError(f"arrays Acnt{m}/Aprior{m}: negative counts or counts in free slots")
+def _sparse_A(arrays: dict, m: int) -> SparseA:
+    """A sparse likelihood's slots as a :class:`SparseA` (free slots hold -1 and no count)."""
+    obs, cnt, prior = arrays[f"Aobs{m}"], arrays[f"Acnt{m}"], arrays[f"Aprior{m}"]
+    if obs.ndim != 2 or obs.dtype.kind not in "iu" or cnt.shape != obs.shape:
+        raise ModelFileError(f"arrays Aobs{m}/Acnt{m}: shapes {obs.shape}/{cnt.shape} ({obs.dtype}), "
+                             "expected integer outcomes and counts of one (states, slots) shape")
+    if obs.size and obs.min() < -1:
+        raise ModelFileError(f"array Aobs{m}: outcome index {int(obs.min())} (free slots hold -1)")
+    if np.any((obs < 0) & (cnt != 0)):
+        raise ModelFileError(f"arrays Aobs{m}/Acnt{m}: counts in free slots")
     ok = obs >= 0
-    s_idx = np.nonzero(ok)[0]
-    return SparseLikelihood.from_counts(prior, (num_obs, obs[ok], s_idx, cnt[ok]), capacity=max(cap, n, 1))
-
-
-def _check(arr: np.ndarray, shape: tuple, name: str) -> np.ndarray:
-    if arr.shape != tuple(shape):
-        raise ModelFileError(f"array {name}: shape {arr.shape}, expected {tuple(shape)}")
-    if arr.dtype.kind == "f" and not np.all(np.isfinite(arr)):
-        raise ModelFileError(f"array {name}: contains NaN or infinite entries")
-    return arr
-
-
-def _check_normalised(model: Model) -> None:
-    for m in range(len(model.modalities)):
-        if model.is_sparse_A(m):
-            if np.any(model.A[m].total() <= 0):
-                raise ModelFileError(f"likelihood '{model.modalities[m].name}': a column has no positive count")
-            continue
-        a = model.live_A(m)
-        if a.size and not np.allclose(a.sum(axis=0), 1.0, atol=1e-6):
-            raise ModelFileError(f"likelihood '{model.modalities[m].name}': columns not normalised")
-    for f in range(len(model.factors)):
-        n = model.num_states[f]
-        B = model.B[f]
-        sums = B.prob[:n].sum(axis=2) if isinstance(B, SparseTransitions) else B.to_dense(n).sum(axis=0)
-        if sums.size and not np.allclose(sums, 1.0, atol=1e-6):
-            raise ModelFileError(f"transitions '{model.factors[f].name}': columns not normalised")
+    return SparseA(prior=prior, outcomes=obs[ok], states=np.nonzero(ok)[0], counts=cnt[ok])

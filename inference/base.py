@@ -19,8 +19,9 @@ Every scheme has the call
   evidence). The metric pose contributes the likelihood ``exp(-|p - poses[s]|^2 / (2 sigma^2))``
   over the live states of the pose factor (the Gaussian's constant ``2 pi sigma^2`` is left
   out, so free energies with pose evidence are defined up to that constant).
-* ``actions``: ``T - 1`` control tuples (one control per factor; a bare int is accepted for a
-  single factor). May be omitted when every factor has a single control.
+* ``actions``: ``T - 1`` control tuples (one integer control per factor; a bare int is accepted
+  for a single factor; floats, strings and bools are refused). May be omitted when every factor
+  has a single control.
 
 ``posterior`` is the per-factor list of beliefs (live length) at the last step and ``info`` an
 :class:`InferenceInfo`.
@@ -33,6 +34,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+
+from cogmap.genmodel.compile import real_array
 
 POSE_KEY = "pose"
 ATOL = 1e-6
@@ -93,10 +96,7 @@ class Problem:
 
 # -- checking --------------------------------------------------------------------------------
 def _check_distribution(x, n_live: int, cap: int, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise InferenceError(f"{what}: not a numeric vector") from None
+    arr = real_array(x, what, InferenceError)  # refuses complex, strings, ragged nesting
     if arr.ndim != 1 or arr.shape[0] not in (n_live, cap):
         raise InferenceError(
             f"{what}: expected a vector of length {n_live} (live) or {cap} (capacity), "
@@ -191,10 +191,7 @@ def pose_evidence(model, pose, t: int = 0) -> Evidence | None:
     if pose is None:
         return None
     pm = model.pose
-    try:
-        p = np.asarray(pose, dtype=float)
-    except (TypeError, ValueError):
-        raise InferenceError(f"observations[{t}] pose: not numeric") from None
+    p = real_array(pose, f"observations[{t}] pose", InferenceError)
     if p.shape != (2,) or not np.all(np.isfinite(p)):
         raise InferenceError(f"observations[{t}] pose: expected finite (x, y), got {pose!r}")
     n = model.num_states[pm.factor]
@@ -203,6 +200,29 @@ def pose_evidence(model, pose, t: int = 0) -> Evidence | None:
     logk = d2 * (-0.5 / (pm.sigma * pm.sigma))
     top = float(logk.max())
     return Evidence((pm.factor,), np.exp(logk - top), top, POSE_KEY)
+
+
+def _controls(a, t: int) -> tuple[int, ...]:
+    """One time step's controls as ints; floats, strings and bools are refused, never truncated
+    or parsed."""
+    if isinstance(a, str | bytes):
+        raise InferenceError(f"actions[{t}]: got the string {a!r}, expected integer control indices")
+    try:
+        arr = np.asarray(a)
+    except (TypeError, ValueError):
+        raise InferenceError(f"actions[{t}]: expected integer control indices, got {a!r}") from None
+    if arr.dtype.kind not in "iu":
+        raise InferenceError(f"actions[{t}]: expected integer control indices, got {a!r} ({arr.dtype.name})")
+    return tuple(int(x) for x in arr.ravel())
+
+
+def check_num_iter(num_iter, scheme: str) -> int:
+    """``num_iter`` must be an integer >= 1 (zero sweeps would return the prior unchanged)."""
+    if isinstance(num_iter, bool | np.bool_) or not isinstance(num_iter, int | np.integer):
+        raise InferenceError(f"{scheme}: num_iter must be an integer >= 1, got {num_iter!r}")
+    if num_iter < 1:
+        raise InferenceError(f"{scheme}: num_iter must be >= 1, got {num_iter}")
+    return int(num_iter)
 
 
 def _check_actions(model, actions, T: int) -> tuple[tuple[int, ...], ...]:
@@ -220,7 +240,7 @@ def _check_actions(model, actions, T: int) -> tuple[tuple[int, ...], ...]:
     for t, a in enumerate(actions):
         if isinstance(a, int | np.integer):
             a = (a,)
-        a = tuple(int(x) for x in np.ravel(np.asarray(a)))
+        a = _controls(a, t)
         if len(a) != F:
             raise InferenceError(f"actions[{t}]: has {len(a)} controls, the model has {F} factor(s)")
         for f, u in enumerate(a):

@@ -14,6 +14,7 @@ import numpy as np
 
 from .base import (
     InferenceInfo,
+    check_num_iter,
     expected_loglik,
     floor_log,
     marginal_loglik,
@@ -69,6 +70,7 @@ def fpi(model, prior, observations, actions=None, *, num_iter: int = 16, tol: fl
     ``num_iter`` sweeps per step (pymdp's default 16); ``tol`` stops early when no belief moves
     by more than ``tol`` (off by default, to keep pymdp's schedule exactly).
     """
+    num_iter = check_num_iter(num_iter, "fpi")
     prob = prepare(model, prior, observations, actions)
     qs = list(prob.prior)
     history = []

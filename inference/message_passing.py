@@ -27,6 +27,7 @@ from .base import (
     LOG_FLOOR,
     InferenceError,
     InferenceInfo,
+    check_num_iter,
     dense_transition,
     expected_loglik,
     floor_log,
@@ -96,6 +97,7 @@ def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
 def _window_scheme(kind: str):
     def scheme(model, prior, observations, actions=None, *, num_iter: int = 16, tau: float = 1.0,
                window: int | None = None):
+        num_iter = check_num_iter(num_iter, kind)
         prob = prepare(model, prior, observations, actions)
         if window is not None and window < 1:
             raise InferenceError(f"{kind}: window must be >= 1, got {window}")

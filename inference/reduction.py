@@ -9,6 +9,15 @@ where ``ln B(a) = sum(gammaln(a)) - gammaln(sum(a))`` per column. ``F`` is the f
 the alternative model minus that of the current one (a negative log-evidence difference), so
 the alternative is accepted exactly when ``F < 0``. The same function serves map expansion
 (``r`` adds a state) and pruning (``r`` removes counts).
+
+Two edge cases are decided explicitly rather than by floating-point luck:
+
+* an exact zero in ``r`` where data was observed (``q - p > 0``) means the alternative gives
+  that data probability zero: ``F = +inf`` and the reduction is rejected (the limit of Eq. 7
+  as ``r -> 0`` there; the formula itself would silently drop the entry);
+* a tie keeps the current model: columns where ``r`` equals ``p`` exactly contribute exactly
+  0 (not a rounding residue), and the alternative is accepted only when ``F < 0`` strictly,
+  so ``F == 0`` rejects it.
 """
 
 from __future__ import annotations
@@ -50,9 +59,12 @@ def reduce_dirichlet(q, p, r, axis: int = 0) -> Reduction:
     if np.any(s < -1e-12):
         raise SpecError("reduce_dirichlet: q + r - p has negative counts (r removes more than was learned)")
     s = np.maximum(s, 0.0)
+    if np.any((r == 0) & (q - p > 0)):  # the alternative cannot explain observed data
+        return Reduction(float("inf"), s, False)
     F = log_beta(q, axis) + log_beta(r, axis) - log_beta(p, axis) - log_beta(s, axis)
+    F = np.where(np.all(r == p, axis=axis), 0.0, F)  # an unchanged column is an exact tie
     total = float(np.sum(F))
-    return Reduction(total, s, total < 0)
+    return Reduction(total, s, total < 0)  # strict: a tie keeps the current model
 
 
 def log_evidence(counts, prior, axis: int = 0) -> float:

@@ -21,6 +21,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
+from ..argtypes import OneLineParser, positive_int
 from .config import STUDIES, run_specs, study_plan
 from .runs import execute
 
@@ -65,8 +66,20 @@ def _run_local(specs, workers: int, sink) -> None:
             sink(f.result())
 
 
+RAY_MISSING = "the ray executor needs Ray, which is not installed; install it with: pip install 'cogmap[ray]'"
+
+
+def require_ray():
+    """The ``ray`` module, or a one-line error saying how to install it."""
+    try:
+        import ray
+    except ImportError:
+        raise RuntimeError(RAY_MISSING) from None
+    return ray
+
+
 def _run_ray(specs, workers: int, address: str | None, sink) -> None:
-    import ray
+    ray = require_ray()
 
     started = False
     if not ray.is_initialized():
@@ -98,6 +111,8 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
 
     from cogmap.runs import git_commit, versions
 
+    if executor == "ray":
+        require_ray()  # before any directory is made
     plan = study_plan(name, scale, envs=envs, seeds=seeds, methods=methods)
     specs = run_specs(plan)
     study_dir = Path(out_dir) / name
@@ -163,17 +178,17 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
 
 
 def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.ArgumentParser:
-    p = parser or argparse.ArgumentParser(prog="cogmap reproduce", description="Reproduce a study of the paper")
+    p = parser or OneLineParser(prog="cogmap reproduce", description="Reproduce a study of the paper")
     p.add_argument("study", choices=STUDIES)
     p.add_argument("--out", default="results", help="output directory (default: results/)")
     p.add_argument("--scale", default="reduced", choices=("reduced", "full", "tiny"))
-    p.add_argument("--workers", type=int, default=1)
+    p.add_argument("--workers", type=positive_int, default=1, help="parallel runs (default: 1)")
     p.add_argument("--executor", default="local", choices=("local", "ray"))
     p.add_argument("--address", default=None, help="Ray cluster address (default: start a local Ray)")
     p.add_argument("--seeds", type=int, nargs="*", default=None)
     p.add_argument("--envs", nargs="*", default=None)
     p.add_argument("--methods", nargs="*", default=None)
-    p.add_argument("--limit", type=int, default=None, help="run at most this many missing runs")
+    p.add_argument("--limit", type=positive_int, default=None, help="run at most this many missing runs")
     p.add_argument("--quiet", action="store_true")
     return p
 
@@ -192,7 +207,9 @@ def run_from_args(args) -> int:
 
 
 def main(argv=None) -> int:
-    return run_from_args(build_parser().parse_args(argv))
+    from cogmap.cli import main as cli_main  # one-line errors, --debug
+
+    return cli_main(["reproduce", *(sys.argv[1:] if argv is None else argv)])
 
 
 if __name__ == "__main__":  # pragma: no cover

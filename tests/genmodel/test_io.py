@@ -81,11 +81,15 @@ def test_corrupt_json_and_missing_file(tmp_path):
 
 
 def test_inconsistent_description(tmp_path):
-    _, js = save(grown_model(), tmp_path / "m")
+    from cogmap.genmodel.io import write_files
+
+    npz, js = save(grown_model(), tmp_path / "m")
     meta = json.loads(js.read_text())
     meta["num_states"] = [3]
-    js.write_text(json.dumps(meta))
-    with pytest.raises(ModelFileError, match=r"array A0: shape \(4, 7\), expected \(4, 3\)"):
+    with np.load(npz) as z:
+        arrays = {k: z[k] for k in z.files}
+    write_files(npz, js, arrays, meta)  # digests valid, content inconsistent
+    with pytest.raises(ModelFileError, match=r"A\['o'\]: shape \(4, 7\), expected \(4, 3\)"):
         load(tmp_path / "m")
 
 

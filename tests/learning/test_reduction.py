@@ -50,3 +50,30 @@ def test_bad_input():
         reduce_dirichlet(np.ones(2), np.ones(3), np.ones(2))
     with pytest.raises(SpecError, match="negative counts"):
         reduce_dirichlet(np.array([1.0, 1.0]), np.array([5.0, 1.0]), np.array([1.0, 1.0]))
+
+
+def test_exact_zero_in_reduced_prior_where_data_was_observed_rejects():
+    p = np.array([1.0, 1.0, 1.0])
+    q = p + np.array([3.0, 0.0, 1.0])  # outcome 2 was observed once
+    r_zero = np.array([1.0, 1.0, 0.0])
+    red = reduce_dirichlet(q, p, r_zero)
+    assert red.free_energy == np.inf and not red.accept
+    # the limit agrees: a tiny reduced prior there gives a large positive F
+    tiny = reduce_dirichlet(q, p, np.array([1.0, 1.0, 1e-12]))
+    assert tiny.free_energy > 20 and not tiny.accept
+    # a zero where nothing was observed is a legitimate reduction (the entry is simply dropped)
+    q2 = p + np.array([3.0, 1.0, 0.0])
+    assert np.isfinite(reduce_dirichlet(q2, p, r_zero).free_energy)
+
+
+def test_ties_keep_the_current_model_exactly():
+    rng = np.random.default_rng(0)
+    p = rng.random((4, 6)) * 3 + 0.1
+    q = p + rng.random((4, 6)) * 5  # fractional counts (learning under uncertain beliefs)
+    same = reduce_dirichlet(q, p, p.copy())
+    assert same.free_energy == 0.0 and not same.accept
+    # only the changed column counts; the unchanged ones add exactly nothing
+    r = p.copy()
+    r[:, 2] *= 2
+    one = reduce_dirichlet(q, p, r).free_energy
+    assert one == reduce_dirichlet(q[:, 2:3], p[:, 2:3], r[:, 2:3]).free_energy
