@@ -191,7 +191,7 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
     obs_dir.mkdir(exist_ok=True)
     import cv2
 
-    for i, img in enumerate(getattr(agent.encoder, "images", [])):
+    for i, img in enumerate(agent.encoder.images):
         cv2.imwrite(str(obs_dir / f"{i:04d}.png"), cv2.cvtColor(np.asarray(img), cv2.COLOR_RGB2BGR))
     with open(out / "trajectory.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=TRAJ_FIELDS)

@@ -68,3 +68,24 @@ def test_planner_uses_the_configured_collision_preference(pref):
     # the breakdown has the sign of G (a penalty is positive)
     assert planner.term_breakdown(agent, efe, 0)["collision"] == pytest.approx(-pref)
     assert planner.term_breakdown(agent, efe, 1)["collision"] == 0.0
+
+
+def test_encoders_follow_the_protocol_and_an_incomplete_one_is_refused():
+    from cogmap.agent.encoder import Encoder, SSIMEncoder
+
+    assert isinstance(SSIMEncoder(), Encoder) and isinstance(CellEncoder(), Encoder)
+
+    class Bare:  # only callable: the agent reads last_scores and saves images
+        def __call__(self, image):
+            return 0, False
+
+    with pytest.raises(TypeError, match="Bare is not an Encoder: it lacks images, last_scores, match"):
+        AIMAPPAgent(AgentConfig(), encoder=Bare())
+
+
+def test_cell_encoder_match_stores_nothing():
+    enc = CellEncoder(1.0)
+    assert enc.match((0.2, 0.2)) == (-1, 0.0)
+    assert enc((0.2, 0.2)) == (0, True)
+    assert enc.match((0.7, 0.4)) == (0, 1.0) and enc.match((1.5, 0.2)) == (-1, 0.0)
+    assert len(enc.ids) == 1
