@@ -34,7 +34,7 @@ def _goal(args) -> int:
 def _compare(args) -> int:
     import numpy as np
 
-    from .compare import compare_inference, format_table, generate_sequence, load_model
+    from cogmap.inference.compare import compare_inference, format_table, generate_sequence, load_model
 
     if args.steps < 1:
         print(f"cogmap compare-inference: --steps must be at least 1, got {args.steps}", file=sys.stderr)
