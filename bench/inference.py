@@ -19,10 +19,10 @@ import time
 
 import numpy as np
 
-from cogmap.compare import generate_sequence
 from cogmap.genmodel import Factor, Modality, ModelSpec, PoseSpec, SparseB, compile
 from cogmap.inference import bayes_filter as filter_scheme
 from cogmap.inference import fpi
+from cogmap.inference.compare import generate_sequence
 
 U, STAY, SLOTS = 13, 12, 8
 DENSE_BUDGET_GB = 1.5

@@ -41,7 +41,7 @@ def _goal(args) -> int:
 def _compare(args) -> int:
     import numpy as np
 
-    from .compare import compare_inference, format_table, generate_sequence, load_model
+    from cogmap.inference.compare import compare_inference, format_table, generate_sequence, load_model
 
     model = load_model(args.model, np.random.default_rng(args.seed))
     seq = generate_sequence(model, T=args.steps, seed=args.seed)

@@ -11,15 +11,16 @@ from __future__ import annotations
 
 import csv
 import json
-import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
 
-from cogmap.agent.aimapp import AIMAPPAgent, Decision, Sensed
+from cogmap.agent.aimapp import AIMAPPAgent
 from cogmap.agent.config import AgentConfig
-from cogmap.metrics import CoverageTracker, coverage_efficiency, nauc, rmse
+from cogmap.agent.policy import AgentPolicy, sense  # noqa: F401  (sense: kept importable from here)
+from cogmap.harness import Episode, coverage_tracker, run_episode
+from cogmap.metrics import coverage_efficiency, nauc, rmse
 
 TRAJ_FIELDS = [
     "step", "true_x", "true_y", "true_yaw", "odom_x", "odom_y", "odom_yaw", "belief_x", "belief_y", "belief_yaw",
@@ -45,17 +46,6 @@ def default_config(env: str) -> AgentConfig:
     return AgentConfig(influence_radius=2.0 if large else 1.0)
 
 
-@dataclass
-class Episode:
-    """What a run produced (kept in memory; :func:`write_run` stores it)."""
-
-    rows: list[dict] = field(default_factory=list)
-    coverage: list[float] = field(default_factory=list)
-    distance: list[float] = field(default_factory=list)
-    decision_ms: list[float] = field(default_factory=list)
-    num_states: list[int] = field(default_factory=list)
-
-
 def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
     """The room, with the start pose chosen by the seed: every seed starts somewhere else, as in
     the paper's protocol (the layout's start poses first, then poses sampled from the free
@@ -70,82 +60,13 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
     return NavSim(layout, sim_cfg, seed=seed, start=seed_start(layout, seed, sim_cfg.robot_radius))
 
 
-def sense(sim, moved: bool | None, cfg: AgentConfig) -> Sensed:
-    """Panorama, odometry and the corridor obstacle signal (odometry frame) from the robot."""
-    from cogmap.agent.sensing import corridor_obstacles, scan_points
-
-    ranges, odom = sim.lidar(), sim.odometry()
-    obstacles = points = None
-    if ranges is not None and odom is not None:
-        angles = sim.lidar_angles() + odom[2]  # beams in the odometry frame
-        obstacles = corridor_obstacles(ranges, angles, cfg.num_headings, cfg.influence_radius,
-                                       cfg.robot_radius + cfg.obstacle_margin, sim.config.lidar_range)
-        points = scan_points(ranges, angles, sim.config.lidar_range)
-    return Sensed(sim.panorama(), obstacles, odom, moved, points)
-
-
-def act(sim, agent: AIMAPPAgent, d: Decision) -> bool:
-    if d.action == agent.cfg.stay:
-        return bool(sim.stay().success)
-    return bool(sim.move_to(d.waypoint, frame="odom").success)
-
-
-def coverage_tracker(sim) -> CoverageTracker:
-    """The LiDAR coverage of this simulator run, over the free area reachable from where the run
-    began. Kept with the simulator so that runs that follow one another (exploration, then a
-    goal) keep adding to the same coverage."""
-    if not hasattr(sim, "_coverage"):
-        free = sim.grid.reachable(sim.true_pose()[:2])
-        sim._coverage = CoverageTracker(free, sim.grid.origin, sim.grid.resolution)
-    return sim._coverage
-
-
 def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episode: Episode | None = None,
               on_step=None, stop=None, desc: str = "explore") -> Episode:
-    """Drive ``agent`` in ``sim`` for ``steps`` decisions, tracking LiDAR coverage."""
-    from tqdm import tqdm
-
-    ep = episode or Episode()
-    tracker = coverage_tracker(sim)
-    moved: bool | None = None
-    dist = ep.distance[-1] if ep.distance else 0.0
-    bar = tqdm(range(steps), disable=not progress, desc=desc, unit="step", leave=True)
-    for _ in bar:
-        if not sim.faults.dropped("lidar", sim.step_count):  # a silent LiDAR senses nothing
-            tracker.update(sim.lidar_hits()[0])
-        sensed = sense(sim, moved, agent.cfg)
-        t0 = time.perf_counter()
-        d = agent.step(sensed)
-        ms = 1e3 * (time.perf_counter() - t0)
-        true, odom = sim.true_pose(), sensed.odometry
-        belief = agent.believed_pose_yaw(odom) if odom is not None else np.full(3, np.nan)
-        ep.coverage.append(tracker.coverage)
-        ep.distance.append(dist)
-        ep.decision_ms.append(ms)
-        ep.num_states.append(agent.num_states)
-        odom = np.full(3, np.nan) if odom is None else odom
-        ep.rows.append(dict(
-            step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
-            odom_yaw=odom[2], belief_x=belief[0], belief_y=belief[1], belief_yaw=belief[2],
-            state=d.state, action=d.action, mode=d.mode, missing="+".join(d.missing), moved=moved,
-            num_states=agent.num_states,
-            num_obs=0 if agent.model is None else agent.model.num_obs[0], coverage=tracker.coverage,
-            distance=dist, decision_ms=ms,
-        ))
-        bar.set_postfix(cov=f"{tracker.coverage:.0%}", states=agent.num_states,
-                        mode=d.mode[:5] + ("-" + "/".join(d.missing) if d.missing else ""))
-        if on_step is not None:
-            on_step(d)
-        before = sim.true_pose()[:2]
-        moved = act(sim, agent, d)
-        dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
-        if stop is not None and stop(d):
-            break
-    if not sim.faults.dropped("lidar", sim.step_count):
-        tracker.update(sim.lidar_hits()[0])
-    ep.coverage.append(tracker.coverage)
-    ep.distance.append(dist)
-    return ep
+    """Drive ``agent`` in ``sim`` for ``steps`` decisions, tracking LiDAR coverage (the
+    harness's :func:`cogmap.harness.run_episode`; ``on_step`` and ``stop`` get the agent's
+    :class:`Decision`)."""
+    return run_episode(sim, AgentPolicy(agent), steps, progress=progress, episode=episode, on_step=on_step,
+                       stop=stop, desc=desc)
 
 
 def episode_metrics(sim, ep: Episode) -> dict:
@@ -191,7 +112,7 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
     obs_dir.mkdir(exist_ok=True)
     import cv2
 
-    for i, img in enumerate(getattr(agent.encoder, "images", [])):
+    for i, img in enumerate(agent.encoder.images):
         cv2.imwrite(str(obs_dir / f"{i:04d}.png"), cv2.cvtColor(np.asarray(img), cv2.COLOR_RGB2BGR))
     with open(out / "trajectory.csv", "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=TRAJ_FIELDS)

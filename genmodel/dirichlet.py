@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .numerics import normalise
 from .spec import SpecError
 
 
@@ -22,8 +23,7 @@ def update_pA(pA: np.ndarray, obs, qs: list[np.ndarray], lr: float = 1.0, floor:
 
 def normalise_counts(p: np.ndarray) -> np.ndarray:
     """Expected parameters of Dirichlet counts (columns over the first axis)."""
-    s = p.sum(axis=0, keepdims=True)
-    return np.where(s > 0, p / np.where(s > 0, s, 1.0), 1.0 / p.shape[0])
+    return normalise(p, axis=0)
 
 
 def as_distribution(obs, n: int) -> np.ndarray:

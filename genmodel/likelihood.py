@@ -34,14 +34,14 @@ from scipy.special import digamma
 
 from .capacity import pad_axis
 from .dirichlet import as_distribution, normalise_counts, update_pA
+from .numerics import LOG_FLOOR, xlogx
 from .spec import SpecError
 
-EPS = float(np.finfo(float).eps)
+EPS = LOG_FLOOR  # the shared log floor (cogmap.genmodel.numerics)
 SUPPORT_CUTOFF = 1e-12  # belief mass below which a learning update leaves a column alone
 
 
-def _xlogx(x: np.ndarray) -> np.ndarray:
-    return x * np.log(np.maximum(x, EPS))
+_xlogx = xlogx
 
 
 def _novelty(a: np.ndarray, a0: np.ndarray) -> np.ndarray:

@@ -19,7 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
+from .numerics import normalise  # noqa: F401  (re-exported: cogmap.genmodel.spec.normalise)
 
 
 class SpecError(ValueError):
@@ -126,9 +126,4 @@ class ModelSpec:
     collision_preference: float | None = None  # log-preference against a collision outcome
 
 
-def normalise(x: np.ndarray, axis: int = 0) -> np.ndarray:
-    """Normalise along ``axis``; all-zero columns become uniform."""
-    x = np.asarray(x, dtype=float)
-    s = x.sum(axis=axis, keepdims=True)
-    n = x.shape[axis]
-    return np.where(s > 0, x / np.where(s > 0, s, 1.0), 1.0 / n)
+

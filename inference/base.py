@@ -36,11 +36,12 @@ from typing import NamedTuple
 import numpy as np
 
 from cogmap.genmodel.compile import real_array
+from cogmap.genmodel.numerics import LOG_FLOOR, floor_log, softmax, xlogx_sum  # noqa: F401  (re-exported)
 
 POSE_KEY = "pose"
 ATOL = 1e-6
 #: floor used inside logarithms by the variational schemes (the same floor as pymdp 1.0)
-LOG_FLOOR = float(np.finfo(float).eps)
+
 
 
 class InferenceError(ValueError):
@@ -276,18 +277,7 @@ def prepare(model, prior, observations, actions=None) -> Problem:
 
 
 # -- small maths -----------------------------------------------------------------------------
-def floor_log(x: np.ndarray) -> np.ndarray:
-    return np.log(np.maximum(x, LOG_FLOOR))
-
-
-def softmax(x: np.ndarray) -> np.ndarray:
-    e = np.exp(x - x.max())
-    return e / e.sum()
-
-
-def xlogx_sum(q: np.ndarray) -> float:
-    nz = q > 0
-    return float(np.sum(q[nz] * np.log(q[nz])))
+# floor_log, softmax, xlogx_sum and LOG_FLOOR: cogmap.genmodel.numerics (imported above)
 
 
 def dense_transition(model, f: int, u: int) -> np.ndarray:

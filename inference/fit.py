@@ -27,6 +27,7 @@ from typing import NamedTuple
 import numpy as np
 from scipy.special import digamma, gammaln
 
+from cogmap.genmodel.numerics import TINY_FLOOR, floor_log
 from cogmap.genmodel.spec import SpecError
 
 
@@ -113,7 +114,7 @@ def fit(model, sequences: Sequence, *, learn_A: bool = True, learn_B: bool = Tru
     d = model.live_D(0)
     history: list[float] = []
     for _ in range(iterations):
-        logA = [_elog(a[m]) if learn_A else np.log(np.maximum(model.live_A(m), 1e-300)) for m in range(M)]
+        logA = [_elog(a[m]) if learn_A else floor_log(model.live_A(m), TINY_FLOOR) for m in range(M)]
         trans = ([np.exp(_elog(b[:, :, u])) for u in range(U)] if learn_B
                  else [model.live_B(0)[:, :, u] for u in range(U)])
         F = 0.0

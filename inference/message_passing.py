@@ -34,14 +34,10 @@ from .base import (
     marginal_loglik,
     predict_factorised,
     prepare,
+    softmax,
     xlogx_sum,
 )
 from .fpi import fpi_step
-
-
-def _softmax_rows(x: np.ndarray) -> np.ndarray:
-    e = np.exp(x - x.max())
-    return e / e.sum()
 
 
 def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
@@ -77,7 +73,7 @@ def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
                         fwd = 0.5 * fwd
                     bwd = 0.0 if last else 0.5 * floor_log(qs[t + 1][f] @ Bn[t][f])
                 ln_q = ln_q + tau * (ln_a - ln_q + bwd + fwd)
-                row.append(_softmax_rows(ln_q))
+                row.append(softmax(ln_q))
             new.append(row)
         qs = new
     # mean-field free energy of the window, split so the last step's terms can be reported

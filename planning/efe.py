@@ -19,17 +19,14 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import digamma
 
-EPS = float(np.finfo(float).eps)
+from cogmap.genmodel.numerics import LOG_FLOOR, xlogx
+
+EPS = LOG_FLOOR  # the shared log floor (cogmap.genmodel.numerics)
 
 Term = Callable[[object], np.ndarray]
 
 
 # -- numerics shared by the backends -------------------------------------------------------
-def xlogx(x: np.ndarray) -> np.ndarray:
-    """``x log x`` with ``0 log 0 = 0`` (log clipped at machine epsilon)."""
-    return x * np.log(np.maximum(x, EPS))
-
-
 def entropy(p: np.ndarray, axis: int = -1) -> np.ndarray:
     """Shannon entropy along ``axis``."""
     return -xlogx(p).sum(axis=axis)

@@ -7,6 +7,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from cogmap.genmodel.numerics import softmax
+
 from .arrays import Prepared, as_arrays, prepare
 from .context import DenseStep
 from .efe import Objective
@@ -67,12 +69,6 @@ def _evaluate(arrays, qs, policies, objective, obstacles, per_step):
         q = ctx.qs
     G = steps.sum(axis=1)
     return (G, steps) if per_step else G
-
-
-def softmax(x: np.ndarray) -> np.ndarray:
-    z = x - np.max(x)
-    e = np.exp(z)
-    return e / e.sum()
 
 
 def policy_posterior(G: np.ndarray, gamma: float = 16.0, log_E: np.ndarray | None = None) -> np.ndarray:

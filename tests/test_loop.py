@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from cogmap import loop
-from cogmap.demo_models import corridor, tmaze
 from cogmap.genmodel import Factor, Modality, ModelSpec, SpecError, compile
+from cogmap.genmodel.demo_models import corridor, tmaze
 from cogmap.genmodel.dirichlet import update_pA
 from cogmap.inference.learning import update_pB
 

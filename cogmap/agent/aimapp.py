@@ -41,7 +41,7 @@ from . import planner
 from .confidence import Confidence, assess, cusum
 from .config import AgentConfig
 from .correction import Anchor, relocalise, to_frame_panorama, track
-from .encoder import Encoder, SSIMEncoder
+from .encoder import Encoder, SSIMEncoder, check_encoder
 from .mapping import direction, expansion_free_energies, reverse_heading
 from .sensing import blocked
 from .viewmap import ViewMap
@@ -103,7 +103,8 @@ class AIMAPPAgent:
     def __init__(self, config: AgentConfig | None = None, encoder: Encoder | None = None, seed: int = 0,
                  model: Model | None = None):
         self.cfg = config or AgentConfig()
-        self.encoder = encoder if encoder is not None else SSIMEncoder(self.cfg.ssim_threshold)
+        self.encoder: Encoder = encoder if encoder is not None else SSIMEncoder(self.cfg.ssim_threshold)
+        check_encoder(self.encoder)
         self.rng = np.random.default_rng(seed)
         self.model = model
         self.q: np.ndarray | None = None
@@ -286,7 +287,7 @@ class AIMAPPAgent:
             # a column's prior mass stays prior_count however many outcomes exist (SparseA), so a
             # taught column keeps its certainty as the vocabulary of views grows
             self.model.add_observation(0)
-        return obs, float(np.max(getattr(self.encoder, "last_scores", [0.0]), initial=0.0))
+        return obs, float(np.max(self.encoder.last_scores, initial=0.0))
 
     def _infer(self, obs: int | None, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
         """Posterior over states and the confidence test (section 3.3, A.1.2); ``obs`` is None

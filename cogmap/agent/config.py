@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, fields
 
 from cogmap.inference.learning import LearningRates
 
@@ -28,7 +28,7 @@ class AgentConfig:
     inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
     inductive_depth: int = 60  # steps over which H propagates goal value back (beyond the MCTS depth)
     inductive_weight: float = 1.0
-    collision_preference: float = -6.0  # log-preference of a collision outcome
+    collision_preference: float = -10.0  # log-preference of a collision outcome (Eq. 6), read by the planner
     prior_count: float = 0.1  # Dirichlet mass of a new column (A_o: spread over the outcomes; B_s: on staying)
     obs_learning_rate: float = 4.0  # counts added when an observation is tied to a state
     relocalise_ssim: float = 0.9  # without LiDAR: a recognised view this similar re-localises onto its state
@@ -82,8 +82,18 @@ class AgentConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> AgentConfig:
+        """The inverse of :meth:`to_dict` (also after a JSON round trip): every field is kept,
+        the nested learning rates included; an unknown key is a clear error."""
         d = dict(d)
-        if "learning" in d and isinstance(d["learning"], dict):
-            lr = d["learning"]
-            d["learning"] = LearningRates(tuple(lr["forward"]), tuple(lr["reverse"]), lr["floor"])
+        _check_keys(cls, d)
+        if isinstance(d.get("learning"), dict):
+            lr = dict(d["learning"])
+            _check_keys(LearningRates, lr)
+            d["learning"] = LearningRates(**{k: tuple(v) if isinstance(v, list) else v for k, v in lr.items()})
         return cls(**d)
+
+
+def _check_keys(cls, d: dict) -> None:
+    unknown = sorted(set(d) - {f.name for f in fields(cls)})
+    if unknown:
+        raise ValueError(f"{cls.__name__}: unknown field(s) {', '.join(map(repr, unknown))}")

@@ -12,7 +12,8 @@ panoramas costs a handful of OpenCV calls.
 
 from __future__ import annotations
 
-from typing import Protocol
+from collections.abc import Sequence
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 
@@ -21,9 +22,31 @@ C2 = (0.03 * 255) ** 2
 BATCH = 128  # OpenCV 5 refuses GaussianBlur on more than 128 channels
 
 
+@runtime_checkable
 class Encoder(Protocol):
+    """What the agent and its run directory use of an encoder, and nothing more.
+
+    ``images`` are the stored observations in id order (a run directory saves them as image
+    files; an encoder that keeps no images gives an empty sequence). ``last_scores`` are the
+    similarities of the latest query to the stored observations it was compared with (empty
+    when nothing was compared); the agent uses their maximum to judge how familiar a view is.
+    """
+
+    images: Sequence[np.ndarray]
+    last_scores: np.ndarray
+
     def __call__(self, image: np.ndarray) -> tuple[int, bool]:
-        """Return (observation id, whether the id is new)."""
+        """Return (observation id, whether the id is new); a new id stores the image."""
+
+    def match(self, image: np.ndarray) -> tuple[int, float]:
+        """Best stored id and its similarity score, storing nothing ((-1, 0.0) when empty)."""
+
+
+def check_encoder(encoder) -> None:
+    """A clear error naming what an encoder lacks of the :class:`Encoder` protocol."""
+    missing = [name for name in ("images", "last_scores", "__call__", "match") if not hasattr(encoder, name)]
+    if missing:
+        raise TypeError(f"{type(encoder).__name__} is not an Encoder: it lacks {', '.join(missing)}")
 
 
 def _cv2():

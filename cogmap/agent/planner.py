@@ -62,7 +62,7 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
                 objective = efe.sensed_exploration(inductive_weight=cfg.explore_inductive_weight)
                 view = views.fractions(areas)
             # else: nothing reachable is left unseen; the paper's terms alone (the model still learns)
-    arrays = from_model(model, goal_states=goal_states, view=view)
+    arrays = from_model(model, goal_states=goal_states, view=view, collision_pref=cfg.collision_preference)
     d = mcts_decide(arrays, [agent.q[:n]], obstacles, objective, config=mcfg, rng=agent.rng)
     out = {"actions": d.actions, "Q": d.Q, "visits": d.visits, "objective": objective, "arrays": arrays,
            "obstacles": obstacles}

@@ -21,9 +21,18 @@ class CellEncoder:
         self.cell = cell
         self.ids: dict[tuple[int, int], int] = {}
         self.last_scores = np.zeros(0)
+        self.images: list[np.ndarray] = []  # it keeps no images (its "images" are positions)
+
+    def _key(self, xy) -> tuple[int, int]:
+        return int(np.floor(xy[0] / self.cell)), int(np.floor(xy[1] / self.cell))
+
+    def match(self, xy) -> tuple[int, float]:
+        """The id of the cell of ``xy`` with score 1, or (-1, 0.0) for a cell never seen."""
+        i = self.ids.get(self._key(xy), -1)
+        return i, float(i >= 0)
 
     def __call__(self, xy) -> tuple[int, bool]:
-        key = (int(np.floor(xy[0] / self.cell)), int(np.floor(xy[1] / self.cell)))
+        key = self._key(xy)
         new = key not in self.ids
         if new:
             self.ids[key] = len(self.ids)

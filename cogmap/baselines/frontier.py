@@ -40,6 +40,7 @@ from scipy import ndimage
 from cogmap.envs.occupancy import OccupancyGrid
 
 from .gridnav import coarsen, extract_path, inflate, line_free, next_waypoint, shortest_paths
+from .policy import BaselinePolicy
 
 
 @dataclass(frozen=True)
@@ -140,7 +141,7 @@ class Frontier:
     cost: float
 
 
-class FrontierExplorer:
+class FrontierExplorer(BaselinePolicy):
     """Greedy frontier exploration on the robot's own odometry-frame map."""
 
     mode = "frontier"
@@ -290,7 +291,7 @@ class FrontierExplorer:
         return wp
 
     # ------------------------------------------------------------------ policy interface
-    def step(self, sim, moved: bool | None):
+    def plan(self, sim, moved: bool | None):
         """Sense (LiDAR + odometry only), update the map, return (waypoint, frame) or None."""
         odom = sim.odometry()
         self.observe(odom, sim.lidar(), sim.lidar_angles(), moved)

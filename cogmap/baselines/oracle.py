@@ -20,6 +20,7 @@ import numpy as np
 from cogmap.metrics import scan_mask
 
 from .gridnav import coarsen, extract_path, inflate, line_free, next_waypoint, shortest_paths
+from .policy import BaselinePolicy
 
 
 @dataclass(frozen=True)
@@ -52,7 +53,7 @@ def visible_mask(occupied: np.ndarray, origin, resolution: float, xy, rays: int,
     return scan_mask(occupied.shape, origin, resolution, end)
 
 
-class OracleTour:
+class OracleTour(BaselinePolicy):
     mode = "oracle"
 
     def __init__(self, config: OracleConfig | None = None):
@@ -82,7 +83,7 @@ class OracleTour:
         self.ready = True
 
     def _seen(self, sim) -> np.ndarray:
-        from .runner import coverage_tracker
+        from cogmap.harness import coverage_tracker
 
         return coverage_tracker(sim).seen.ravel()
 
@@ -106,7 +107,7 @@ class OracleTour:
         self.target, self.path = j, pts
         return True
 
-    def step(self, sim, moved: bool | None):
+    def plan(self, sim, moved: bool | None):
         """Uses the true pose, the true grid and the coverage so far (an informed operator)."""
         cfg = self.cfg
         if not self.ready:

@@ -8,15 +8,17 @@ from __future__ import annotations
 
 import numpy as np
 
+from .policy import BaselinePolicy
 
-class RandomWalk:
+
+class RandomWalk(BaselinePolicy):
     mode = "random"
 
     def __init__(self, step_length: float = 1.0, seed: int = 0):
         self.step_length = float(step_length)
         self.rng = np.random.default_rng(seed)
 
-    def step(self, sim, moved: bool | None):
+    def plan(self, sim, moved: bool | None):
         odom = sim.odometry()
         h = float(self.rng.uniform(0.0, 2 * np.pi))
         if odom is None:  # no odometry: move blind relative to the true pose cannot be commanded

@@ -194,7 +194,7 @@ def sharp_model(seed, sizes=(4, 3)):
 @pytest.mark.parametrize("seed", SEEDS)
 @pytest.mark.parametrize("name", ["fpi", "vmp", "mmp"])
 def test_map_agrees_on_well_conditioned_models(seed, name):
-    from cogmap.compare import generate_sequence
+    from cogmap.inference.compare import generate_sequence
 
     m = sharp_model(seed)
     seq = generate_sequence(m, 5, seed)

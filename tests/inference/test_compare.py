@@ -3,7 +3,7 @@
 import numpy as np
 from inference_helpers import pose_model, random_model
 
-from cogmap.compare import Row, compare_inference, format_table, generate_sequence
+from cogmap.inference.compare import Row, compare_inference, format_table, generate_sequence
 
 
 def test_harness_runs_and_exact_has_zero_kl():

@@ -1,0 +1,144 @@
+"""One episode loop for every exploration policy in a ``NavSim`` (AIMAPP and the baselines).
+
+The harness owns what is not the policy's business: the episode record (trajectory rows,
+coverage, distance, decision time), the LiDAR coverage of the run (ground truth, for the
+metrics), acting on the simulator and the stopping rules. A policy follows :class:`Policy`:
+
+- ``sense(sim, moved)`` reads the sensors it is allowed (not timed; ``moved`` is the outcome of
+  the last motion command, None before the first);
+- ``step(sensed) -> Command`` decides (timed: ``decision_ms``); the command says where to go
+  (or to stay, or that the policy has finished) and carries the policy's own trajectory fields.
+
+:class:`cogmap.agent.policy.AgentPolicy` wraps the AIMAPP agent; the baselines
+(:mod:`cogmap.baselines`) implement it through :class:`cogmap.baselines.policy.BaselinePolicy`.
+"""
+
+from __future__ import annotations
+
+import time
+import weakref
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
+
+import numpy as np
+
+from cogmap.metrics import CoverageTracker
+
+
+@dataclass
+class Episode:
+    """What a run produced (kept in memory; :func:`cogmap.explore.write_run` stores it)."""
+
+    rows: list[dict] = field(default_factory=list)
+    coverage: list[float] = field(default_factory=list)
+    distance: list[float] = field(default_factory=list)
+    decision_ms: list[float] = field(default_factory=list)
+    num_states: list[int] = field(default_factory=list)
+
+
+@dataclass
+class Command:
+    """A policy's decision at one step, as the harness executes and records it.
+
+    ``waypoint`` is where to drive in ``frame`` ("odom" or "world"), None to stay in place;
+    ``done`` means the policy has finished (the step is recorded, nothing is executed and the
+    episode ends). ``row`` holds the policy's own trajectory fields (believed pose, state,
+    action, mode, ...; see :data:`cogmap.explore.TRAJ_FIELDS`), ``status`` extra fields for the
+    progress bar and ``decision`` the policy's own decision object, handed to ``on_step`` and
+    ``stop``."""
+
+    waypoint: np.ndarray | None
+    frame: str = "odom"
+    row: dict = field(default_factory=dict)
+    done: bool = False
+    status: dict = field(default_factory=dict)
+    decision: Any = None
+
+
+@runtime_checkable
+class Policy(Protocol):
+    """What the harness needs of a policy."""
+
+    label: str  # progress-bar description
+
+    def sense(self, sim, moved: bool | None) -> Any:
+        """What the policy senses this step (read from ``sim``, only the streams it may use)."""
+
+    def step(self, sensed) -> Command:
+        """Decide from ``sensed``."""
+
+
+# The coverage of a simulator run is kept per simulator (runs that follow one another in one
+# simulator, e.g. exploration then a goal, keep adding to it) without touching the simulator.
+_TRACKERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def coverage_tracker(sim) -> CoverageTracker:
+    """The LiDAR coverage of this simulator run, over the free area reachable from where the run
+    began (created at the first call for ``sim``)."""
+    tracker = _TRACKERS.get(sim)
+    if tracker is None:
+        free = sim.grid.reachable(sim.true_pose()[:2])
+        tracker = _TRACKERS[sim] = CoverageTracker(free, sim.grid.origin, sim.grid.resolution)
+    return tracker
+
+
+def sweep(sim, tracker: CoverageTracker) -> None:
+    """Add what the LiDAR sweeps now to the coverage (nothing while the LiDAR is silent)."""
+    if not sim.faults.dropped("lidar", sim.step_count):
+        tracker.update(sim.lidar_hits()[0])
+
+
+def execute(sim, command: Command) -> bool:
+    """Drive (or stay) as commanded; returns whether the motion succeeded."""
+    if command.waypoint is None:
+        return bool(sim.stay().success)
+    return bool(sim.move_to(command.waypoint, frame=command.frame).success)
+
+
+def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, episode: Episode | None = None,
+                on_step=None, stop=None, stop_coverage: float | None = None, desc: str | None = None) -> Episode:
+    """Drive ``policy`` in ``sim`` for at most ``steps`` decisions, tracking LiDAR coverage.
+
+    Ends early when the policy reports ``done``, when ``stop(decision)`` is true after a step
+    was executed, or when the coverage reaches ``stop_coverage`` before a decision. Passing the
+    ``episode`` of an earlier run continues it (rows, distance)."""
+    from tqdm import tqdm
+
+    ep = episode if episode is not None else Episode()
+    tracker = coverage_tracker(sim)
+    moved: bool | None = None
+    dist = ep.distance[-1] if ep.distance else 0.0
+    bar = tqdm(range(steps), disable=not progress, desc=desc or policy.label, unit="step", leave=True)
+    for _ in bar:
+        sweep(sim, tracker)
+        if stop_coverage is not None and tracker.coverage >= stop_coverage:
+            break
+        sensed = policy.sense(sim, moved)
+        t0 = time.perf_counter()
+        cmd = policy.step(sensed)
+        ms = 1e3 * (time.perf_counter() - t0)
+        true, odom = sim.true_pose(), sim.odometry()
+        odom = np.full(3, np.nan) if odom is None else odom
+        ep.coverage.append(tracker.coverage)
+        ep.distance.append(dist)
+        ep.decision_ms.append(ms)
+        ep.num_states.append(int(cmd.row.get("num_states", 0)))
+        ep.rows.append(dict(
+            step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
+            odom_yaw=odom[2], **cmd.row, moved=moved, coverage=tracker.coverage, distance=dist, decision_ms=ms,
+        ))
+        bar.set_postfix(cov=f"{tracker.coverage:.0%}", **cmd.status)
+        if cmd.done:
+            break
+        if on_step is not None:
+            on_step(cmd.decision)
+        before = sim.true_pose()[:2]
+        moved = execute(sim, cmd)
+        dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
+        if stop is not None and stop(cmd.decision):
+            break
+    sweep(sim, tracker)
+    ep.coverage.append(tracker.coverage)
+    ep.distance.append(dist)
+    return ep

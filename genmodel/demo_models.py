@@ -1,0 +1,71 @@
+"""Small built-in models (T-maze, corridor, random) for ``cogmap compare-inference``, the
+tutorials and quick experiments.
+
+Each builder takes a numpy Generator and returns a compiled model.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .compile import compile
+from .model import Model
+from .numerics import normalise
+from .spec import Factor, Modality, ModelSpec
+
+
+def tmaze(rng: np.random.Generator | None = None) -> Model:
+    """Two factors (location x4 with 4 moves, context x2) and three modalities."""
+    centre, left, right, cue = range(4)
+    B_loc = np.zeros((4, 4, 4))
+    for u in range(4):
+        B_loc[u, :, u] = 1.0
+    A_reward = np.zeros((3, 4, 2))
+    A_reward[0, [centre, cue], :] = 1.0
+    A_reward[1, left, 0] = A_reward[2, left, 1] = A_reward[1, right, 1] = A_reward[2, right, 0] = 0.9
+    A_reward[2, left, 0] = A_reward[1, left, 1] = A_reward[2, right, 1] = A_reward[1, right, 0] = 0.1
+    A_cue = np.full((2, 4, 2), 0.5)
+    A_cue[:, cue, :] = [[0.95, 0.05], [0.05, 0.95]]
+    return compile(ModelSpec(
+        factors=[Factor("location", 4, num_controls=4), Factor("context", 2)],
+        modalities=[Modality("where", 4, ("location",)), Modality("reward", 3, ("location", "context")),
+                    Modality("cue", 2, ("location", "context"))],
+        A={"where": 0.9 * np.eye(4) + 0.025, "reward": A_reward, "cue": A_cue},
+        B={"location": 0.9 * B_loc + 0.025, "context": np.eye(2)[:, :, None]},
+        D={"location": np.eye(4)[centre]},
+    ))
+
+
+def corridor(rng: np.random.Generator | None = None, n: int = 8) -> Model:
+    """A corridor of ``n`` places with aliased colours and slippery moves (stay, east, west)."""
+    rng = rng or np.random.default_rng(0)
+    B = np.zeros((n, n, 3))
+    B[:, :, 0] = np.eye(n)
+    for s in range(n):
+        B[min(s + 1, n - 1), s, 1] += 0.8
+        B[s, s, 1] += 0.2
+        B[max(s - 1, 0), s, 2] += 0.8
+        B[s, s, 2] += 0.2
+    colours = rng.integers(0, 3, size=n)
+    A = np.full((3, n), 0.05)
+    A[colours, np.arange(n)] = 0.9
+    return compile(ModelSpec(
+        factors=[Factor("place", n, num_controls=3, stay=0)],
+        modalities=[Modality("colour", 3, ("place",))],
+        A={"colour": A},
+        B={"place": B},
+    ))
+
+
+def random_model(rng: np.random.Generator | None = None) -> Model:
+    """Two factors (3 and 4 states, 2 controls each), two modalities on different factors."""
+    rng = rng or np.random.default_rng(0)
+    return compile(ModelSpec(
+        factors=[Factor("a", 3, num_controls=2), Factor("b", 4, num_controls=2)],
+        modalities=[Modality("x", 4, ("a",)), Modality("y", 3, ("a", "b"))],
+        A={"x": normalise(rng.random((4, 3)) ** 3), "y": normalise(rng.random((3, 3, 4)) ** 3)},
+        B={"a": normalise(rng.random((3, 3, 2)) ** 4), "b": normalise(rng.random((4, 4, 2)) ** 4)},
+    ))
+
+
+MODELS = {"tmaze": tmaze, "corridor": corridor, "random": random_model}
