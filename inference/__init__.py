@@ -2,7 +2,8 @@
 
 Every scheme: ``posterior, info = scheme(model, prior, observations, actions=None, **options)``
 (conventions in :mod:`cogmap.inference.base`). Built-in names: ``exact``, ``filter``
-(:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``; ``get(name)``, ``register(name, fn)``, ``available()``.
+(:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``, ``particle_filter``
+(continuous states, jax imported on call); ``get(name)``, ``register(name, fn)``, ``available()``.
 """
 
 from .base import (
@@ -18,10 +19,12 @@ from .bayes_filter import bayes_filter
 from .exact import exact
 from .fpi import fpi
 from .message_passing import mmp, vmp
+from .particle_scheme import ParticleModel, particle_filter
 from .pymdp_bridge import to_pymdp
 from .registry import available, get, register, unregister
 
-_BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp))
+_BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp),
+            ("particle_filter", particle_filter))
 for _name, _fn in _BUILTIN:
     register(_name, _fn)
 
@@ -30,6 +33,7 @@ __all__ = [
     "Evidence",
     "InferenceError",
     "InferenceInfo",
+    "ParticleModel",
     "Problem",
     "available",
     "bayes_filter",
@@ -37,6 +41,7 @@ __all__ = [
     "fpi",
     "get",
     "mmp",
+    "particle_filter",
     "predict_factorised",
     "prepare",
     "register",
