@@ -1,5 +1,5 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap reproduce``."""
+``cogmap dvbf slam``, ``cogmap reproduce``."""
 
 from __future__ import annotations
 
@@ -47,6 +47,15 @@ def _compare(args) -> int:
     return 0
 
 
+def _dvbf(args) -> int:
+    from .dvbf.run import slam_run
+
+    metrics = slam_run(args.maze, args.steps, Path(args.out), seed=args.seed, progress=not args.quiet)
+    print(json.dumps(metrics, indent=1))
+    print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, error.png, map.png)")
+    return 0
+
+
 def _reproduce(args) -> int:
     from .study.runner import run_from_args
 
@@ -89,6 +98,16 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--steps", type=int, default=30)
     c.add_argument("--seed", type=int, default=0)
     c.set_defaults(func=_compare)
+
+    d = sub.add_parser("dvbf", help="DVBF-LM in the LiDAR mazes")
+    dsub = d.add_subparsers(dest="dvbf_command", required=True)
+    ds = dsub.add_parser("slam", help="online SLAM on one seeded maze (unit square), against path integration")
+    ds.add_argument("--maze", type=int, default=0, help="maze seed (default: 0)")
+    ds.add_argument("--steps", type=int, default=1000, help="traversal length (default: 1000)")
+    ds.add_argument("--seed", type=int, default=0, help="traversal, noise and filter seed (default: 0)")
+    ds.add_argument("--out", default="runs/dvbf-slam", help="run directory (default: runs/dvbf-slam)")
+    ds.add_argument("--quiet", action="store_true")
+    ds.set_defaults(func=_dvbf)
 
     from .study.runner import build_parser as study_arguments
 

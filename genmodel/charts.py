@@ -25,14 +25,20 @@ def _axis(coord, n: int, extent: float):
     return i0, f
 
 
-def bilinear_read(grid: jax.Array, points: jax.Array, extent: float) -> jax.Array:
-    """Read ``grid (w, h, D)`` at world points ``(..., 2)``; returns ``(..., D)``."""
+def bilinear_read(grid: jax.Array, points: jax.Array, extent: float, power: int = 1) -> jax.Array:
+    """Read ``grid (w, h, D)`` at world points ``(..., 2)``; returns ``(..., D)``.
+
+    ``power=2`` weights the cells by the squared attention, which turns a grid of independent
+    variances into the variance of the read (``Var sum_c a_c M_c = sum_c a_c^2 Var M_c``).
+    """
     w, h = grid.shape[0], grid.shape[1]
     i0, fx = _axis(points[..., 0], w, extent)
     j0, fy = _axis(points[..., 1], h, extent)
     fx, fy = fx[..., None], fy[..., None]
-    return ((1 - fx) * (1 - fy) * grid[i0, j0] + fx * (1 - fy) * grid[i0 + 1, j0]
-            + (1 - fx) * fy * grid[i0, j0 + 1] + fx * fy * grid[i0 + 1, j0 + 1])
+    a00, a10, a01, a11 = (1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy
+    if power != 1:
+        a00, a10, a01, a11 = a00**power, a10**power, a01**power, a11**power
+    return a00 * grid[i0, j0] + a10 * grid[i0 + 1, j0] + a01 * grid[i0, j0 + 1] + a11 * grid[i0 + 1, j0 + 1]
 
 
 def attention_weights(point: jax.Array, shape: tuple[int, int], extent: float) -> jax.Array:
@@ -52,6 +58,7 @@ def beam_query_points(pose: jax.Array, n_beams: int, radii: jax.Array) -> jax.Ar
     return pose[:2] + radii[None, :, None] * d[:, None, :]
 
 
-def chart(grid: jax.Array, pose: jax.Array, extent: float, n_beams: int, radii: jax.Array) -> jax.Array:
+def chart(grid: jax.Array, pose: jax.Array, extent: float, n_beams: int, radii: jax.Array,
+          power: int = 1) -> jax.Array:
     """The chart ``m_t = f_m(z_t, M)`` of shape ``(n_beams, len(radii), D)``."""
-    return bilinear_read(grid, beam_query_points(pose, n_beams, radii), extent)
+    return bilinear_read(grid, beam_query_points(pose, n_beams, radii), extent, power)

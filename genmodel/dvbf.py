@@ -78,9 +78,18 @@ class Emission(eqx.Module):
                               activation=softsign, key=key)
         self.lidar_range = float(cfg.lidar_range)
 
+    def beam(self, row: jax.Array) -> jax.Array:
+        """Mean range of one beam from its chart row ``(n_radii, D)``."""
+        return self.lidar_range * jax.nn.sigmoid(self.mlp(row.reshape(-1))[0])
+
     def __call__(self, m: jax.Array) -> jax.Array:
-        logits = jax.vmap(lambda row: self.mlp(row.reshape(-1))[0])(m)
-        return self.lidar_range * jax.nn.sigmoid(logits)
+        return jax.vmap(self.beam)(m)
+
+    def mean_and_variance(self, m: jax.Array, m_var: jax.Array) -> tuple[jax.Array, jax.Array]:
+        """Mean ranges and their first-order (delta-method) variance under chart variances ``m_var``:
+        ``Var mu_k ~ sum_j (d mu_k / d m_kj)^2 Var m_kj``."""
+        mu, grad = jax.vmap(jax.value_and_grad(self.beam))(m)
+        return mu, jnp.sum(grad**2 * m_var, axis=(1, 2))
 
 
 def predict_scan(emission: Emission, grid: jax.Array, pose: jax.Array, cfg: DVBFConfig) -> jax.Array:
@@ -95,6 +104,26 @@ def log_likelihood(emission: Emission, grid: jax.Array, poses: jax.Array, scan: 
     mu = jax.vmap(lambda z: predict_scan(emission, grid, z, cfg))(poses)
     r = (scan - mu) / s
     return -0.5 * jnp.sum(r * r, -1) - scan.shape[-1] * (jnp.log(s) + 0.5 * LOG_2PI)
+
+
+def log_likelihood_marginal(emission: Emission, q_map, poses: jax.Array, scan: jax.Array, cfg: DVBFConfig,
+                            sigma: float | None = None) -> jax.Array:
+    """``log E_q(M) p(x | z_k, M)`` to first order: per beam a Gaussian around the prediction at the map
+    mean whose variance adds the map's uncertainty carried through the emission (delta method).
+    Beams that look into unlearnt parts of the map (std near the prior's 1) then weigh little."""
+    s = cfg.sigma_e if sigma is None else sigma
+    radii = jnp.asarray(cfg.radii)
+    var_grid = jnp.exp(2.0 * q_map.log_std)
+
+    def one(z):
+        m = chart(q_map.mean, z, cfg.extent, cfg.n_beams, radii)
+        m_var = chart(var_grid, z, cfg.extent, cfg.n_beams, radii, power=2)
+        return emission.mean_and_variance(m, m_var)
+
+    mu, var = jax.vmap(one)(poses)
+    total = s * s + var
+    r2 = (scan - mu) ** 2 / total
+    return -0.5 * jnp.sum(r2 + jnp.log(total), -1) - 0.5 * scan.shape[-1] * LOG_2PI
 
 
 def wrap(a: jax.Array) -> jax.Array:
