@@ -1,5 +1,6 @@
 """DVBF-LM model pieces: latent map, KL, charts, emission, transition."""
 
+import equinox as eqx
 import jax
 import jax.numpy as jnp
 import numpy as np
@@ -30,7 +31,7 @@ def test_kl_matches_closed_form_and_monte_carlo():
     assert float(kl_map(init_map(3, 4, 5))) == 0.0
     # Monte Carlo: E_q[log q - log p] from reparameterised samples
     keys = jax.random.split(jax.random.PRNGKey(1), 4000)
-    samples = np.asarray(jax.vmap(lambda k: sample_map(k, q))(keys))
+    samples = np.asarray(jax.jit(jax.vmap(lambda k: sample_map(k, q)))(keys))
     log_q = -0.5 * ((samples - mean) / np.exp(log_std)) ** 2 - log_std
     log_p = -0.5 * samples**2
     assert np.mean(np.sum(log_q - log_p, axis=(1, 2, 3))) == pytest.approx(expected, rel=0.05)
@@ -64,8 +65,9 @@ def test_query_points_rotate_and_translate():
     assert np.allclose(pts[1, 1], [0.4, 0.4], atol=1e-6)  # beam 1 a quarter turn on (west)
     # rotating the pose by one beam step rotates the chart's rows
     grid = jax.random.normal(jax.random.PRNGKey(0), (6, 6, 3))
-    a = chart(grid, jnp.array([0.5, 0.5, 0.0]), 1.0, 4, radii)
-    b = chart(grid, jnp.array([0.5, 0.5, np.pi / 2]), 1.0, 4, radii)
+    poses = jnp.array([[0.5, 0.5, 0.0], [0.5, 0.5, np.pi / 2]])
+    rows = jax.jit(jax.vmap(lambda z: chart(grid, z, 1.0, 4, radii)))(poses)
+    a, b = rows[0], rows[1]
     assert np.allclose(b[:3], a[1:], atol=1e-5) and np.allclose(b[3], a[0], atol=1e-5)
 
 
@@ -74,10 +76,14 @@ def test_emission_and_likelihood_shapes_and_gaussian():
     em = Emission(cfg, jax.random.PRNGKey(0))
     grid = jax.random.normal(jax.random.PRNGKey(1), (6, 6, cfg.map_dim))
     poses = jnp.array([[0.3, 0.3, 0.0], [0.6, 0.5, 1.0]])
-    mu = jax.vmap(lambda z: predict_scan(em, grid, z, cfg))(poses)
-    assert mu.shape == (2, cfg.n_beams) and np.all((mu > 0) & (mu < cfg.lidar_range))
     scan = jnp.full((cfg.n_beams,), 0.2)
-    ll = log_likelihood(em, grid, poses, scan, cfg)
+
+    @eqx.filter_jit
+    def compute(em):
+        return jax.vmap(lambda z: predict_scan(em, grid, z, cfg))(poses), log_likelihood(em, grid, poses, scan, cfg)
+
+    mu, ll = compute(em)
+    assert mu.shape == (2, cfg.n_beams) and np.all((mu > 0) & (mu < cfg.lidar_range))
     s = cfg.sigma_e
     hand = [np.sum(-0.5 * ((0.2 - np.asarray(m)) / s) ** 2 - np.log(s) - 0.5 * np.log(2 * np.pi)) for m in mu]
     assert np.allclose(ll, hand, rtol=1e-5)
@@ -99,3 +105,32 @@ def test_config_rejects_bad_sizes():
         DVBFConfig(n_radii=3, radii=(0.0, 0.1))
     with pytest.raises(ValueError, match="sigma_e"):
         DVBFConfig(sigma_e=0.0)
+
+
+def test_marginal_likelihood_variance_matches_monte_carlo():
+    # with a small map std the delta-method variance of each predicted range matches sampling q(M)
+    from cogmap.genmodel.dvbf import log_likelihood_marginal
+
+    cfg = DVBFConfig(map_side=6, n_radii=4, hidden=8, depth=1, sigma_e=0.05)
+    em = Emission(cfg, jax.random.PRNGKey(0))
+    mean = jax.random.normal(jax.random.PRNGKey(1), (6, 6, cfg.map_dim))
+    q = MapPosterior(mean, jnp.full(mean.shape, np.log(0.05)))
+    z = jnp.array([0.4, 0.55, 0.3])
+    radii = jnp.asarray(cfg.radii)
+
+    @eqx.filter_jit
+    def compute(em, q):
+        m = chart(q.mean, z, cfg.extent, cfg.n_beams, radii)
+        m_var = chart(jnp.exp(2 * q.log_std), z, cfg.extent, cfg.n_beams, radii, power=2)
+        mu, var = em.mean_and_variance(m, m_var)
+        keys = jax.random.split(jax.random.PRNGKey(2), 2000)
+        samples = jax.vmap(lambda k: predict_scan(em, sample_map(k, q), z, cfg))(keys)
+        return mu, var, samples, log_likelihood_marginal(em, q, z[None], mu + 0.01, cfg)[0]
+
+    mu, var, samples, ll = compute(em, q)
+    assert np.allclose(np.var(np.asarray(samples), 0), var, rtol=0.15, atol=1e-7)
+    assert np.allclose(np.mean(np.asarray(samples), 0), mu, atol=2e-3)
+    # the likelihood is a Gaussian per beam with the inflated variance
+    total = cfg.sigma_e**2 + np.asarray(var)
+    hand = np.sum(-0.5 * 0.01**2 / total - 0.5 * np.log(2 * np.pi * total))
+    assert float(ll) == pytest.approx(hand, rel=1e-4)
