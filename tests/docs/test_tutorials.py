@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
-PAGES = ["tutorial-generative-model.md", "quickstart.md", "tutorial-aimapp.md"]
+PAGES = ["tutorial-generative-model.md", "quickstart.md", "tutorial-aimapp.md", "tutorial-dvbf.md"]
 
 
 def blocks(page: str) -> list[str]:
