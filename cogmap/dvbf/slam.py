@@ -70,8 +70,13 @@ def path_integration(start, controls) -> np.ndarray:
     return np.array(poses)
 
 
-def online_slam(scans, controls, start, config: SLAMConfig, progress=None) -> SLAMResult:
-    """Run online SLAM on ``scans (T, n_beams)`` and ``controls (T - 1, 2)`` from the known ``start``."""
+def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emission=None) -> SLAMResult:
+    """Run online SLAM on ``scans (T, n_beams)`` and ``controls (T - 1, 2)`` from the known ``start``.
+
+    ``emission``: an emission network to start from (for example one trained on a first maze, as
+    the paper pretrains its transition); by default a freshly initialised one. The map always starts
+    at the prior.
+    """
     import equinox as eqx
     import jax
     import jax.numpy as jnp
@@ -89,6 +94,8 @@ def online_slam(scans, controls, start, config: SLAMConfig, progress=None) -> SL
     key = jax.random.PRNGKey(config.seed)
     key, k_init, k_part = jax.random.split(key, 3)
     params = init_params(cfg, k_init)
+    if emission is not None:
+        params = params._replace(emission=emission)
     opt = make_optimizer(config.learning_rate)
     opt_state = init_opt_state(opt, params)
     train_step = make_train_step(cfg, opt, T)
