@@ -50,7 +50,9 @@ def _compare(args) -> int:
 def _dvbf(args) -> int:
     from .dvbf.run import slam_run
 
-    metrics = slam_run(args.maze, args.steps, Path(args.out), seed=args.seed, progress=not args.quiet)
+    pre = None if args.pretrain_maze < 0 else args.pretrain_maze
+    metrics = slam_run(args.maze, args.steps, Path(args.out), seed=args.seed, progress=not args.quiet,
+                       pretrain_maze=pre)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, error.png, map.png)")
     return 0
@@ -102,7 +104,10 @@ def build_parser() -> argparse.ArgumentParser:
     d = sub.add_parser("dvbf", help="DVBF-LM in the LiDAR mazes")
     dsub = d.add_subparsers(dest="dvbf_command", required=True)
     ds = dsub.add_parser("slam", help="online SLAM on one seeded maze (unit square), against path integration")
-    ds.add_argument("--maze", type=int, default=0, help="maze seed (default: 0)")
+    ds.add_argument("--maze", type=int, default=1, help="maze seed (default: 1)")
+    ds.add_argument("--pretrain-maze", type=int, default=0,
+                    help="maze whose traversal with known poses pretrains the emission, then frozen "
+                         "(default: 0; -1: learn the emission online from scratch)")
     ds.add_argument("--steps", type=int, default=1000, help="traversal length (default: 1000)")
     ds.add_argument("--seed", type=int, default=0, help="traversal, noise and filter seed (default: 0)")
     ds.add_argument("--out", default="runs/dvbf-slam", help="run directory (default: runs/dvbf-slam)")

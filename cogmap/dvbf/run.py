@@ -20,7 +20,7 @@ from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
 from cogmap.genmodel.dvbf import DVBFConfig
 
-from .slam import SLAMConfig, online_slam, path_integration
+from .slam import SLAMConfig, online_slam, path_integration, pretrain_emission
 
 NOISE = ActuationNoise(rot_std=0.005, trans_frac=0.05)
 
@@ -58,11 +58,16 @@ def load_params(out: Path):
 
 
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
-             complexity: str = "moderate", corridor: str = "medium", **overrides) -> dict:
+             complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
+             pretrain_steps: int = 2000, pretrain_iters: int = 1500, **overrides) -> dict:
     """Run online SLAM on maze ``maze_seed`` for ``steps`` steps and write the run directory to ``out``.
 
+    With ``pretrain_maze`` (default 0), the emission network is first trained with known poses on a
+    ``pretrain_steps`` traversal of that maze and then frozen; online SLAM learns only q(M).
     ``overrides`` replace :class:`SLAMConfig` fields (for example ``train_iters``); returns the metrics.
     """
+    if pretrain_maze is not None and pretrain_maze == maze_seed:
+        raise ValueError(f"slam_run: the emission is pretrained on maze {pretrain_maze}; evaluate on another maze")
     from cogmap.envs.maze_render import save_maze_png
     from cogmap.runs import write_manifest
 
@@ -72,9 +77,15 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     tr = traverse(maze, steps, seed=seed, noise=NOISE)
     model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64,
                        sigma_t=(0.0005, 0.0005, NOISE.rot_std))
+    emission = None
+    if pretrain_maze is not None:
+        first = traverse(make_maze(pretrain_maze, complexity, corridor), pretrain_steps, seed=seed + 1000, noise=NOISE)
+        emission, _ = pretrain_emission(first.poses, first.scans, model, iters=pretrain_iters, seed=seed)
+        overrides = {"freeze_emission": True, **overrides}
     config = SLAMConfig(model=model, seed=seed, **overrides)
     write_manifest(out, command="dvbf slam", maze_seed=maze_seed, complexity=complexity, corridor=corridor,
-                   steps=steps, seed=seed,
+                   steps=steps, seed=seed, pretrain_maze=pretrain_maze, pretrain_steps=pretrain_steps,
+                   pretrain_iters=pretrain_iters,
                    noise=asdict(NOISE), config=config.to_json())
     bar = None
     if progress:
@@ -88,7 +99,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
             bar.update(t - last[0])
             last[0] = t
 
-    res = online_slam(tr.scans, tr.controls, tr.poses[0], config, progress=tick)
+    res = online_slam(tr.scans, tr.controls, tr.poses[0], config, progress=tick, emission=emission)
     if bar is not None:
         bar.close()
     pi = path_integration(tr.poses[0], tr.controls)
@@ -103,7 +114,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
             w.writerow([t, *np.round(tr.poses[t], 6), *np.round(res.estimates[t], 6), *np.round(res.spreads[t], 6),
                         *np.round(pi[t], 6), round(float(err[t]), 6), round(float(err_pi[t]), 6)])
     metrics = {
-        "maze_seed": maze_seed, "steps": steps, "seed": seed,
+        "maze_seed": maze_seed, "steps": steps, "seed": seed, "pretrain_maze": pretrain_maze,
         "error_final": float(err[-1]), "error_pi_final": float(err_pi[-1]),
         "error_mean": float(err.mean()), "error_pi_mean": float(err_pi.mean()),
         "path_length": float(np.sum(np.hypot(*np.diff(tr.poses[:, :2], axis=0).T))),

@@ -28,10 +28,11 @@ class SLAMConfig:
     per step used by training; ``marginal``: weight particles by the likelihood with the map's
     uncertainty carried to first order (:func:`~cogmap.genmodel.dvbf.log_likelihood_marginal`) rather
     than at the map mean alone; ``recent``: share of each training batch drawn from the last
-    ``recent_window`` steps, so the map where the agent is now is learnt before the filter leans on it."""
+    ``recent_window`` steps, so the map where the agent is now is learnt before the filter leans on it;
+    ``freeze_emission``: keep the starting emission network fixed and learn only q(M)."""
 
     n_particles: int = 20
-    pf_sigma: float = 0.1
+    pf_sigma: float = 0.05
     train_every: int = 10
     train_iters: int = 20
     batch: int = 32
@@ -42,6 +43,7 @@ class SLAMConfig:
     marginal: bool = True
     recent: float = 0.75
     recent_window: int = 100
+    freeze_emission: bool = False
     seed: int = 0
 
     def to_json(self) -> dict:
@@ -68,6 +70,30 @@ def path_integration(start, controls) -> np.ndarray:
         a = a + u[0]
         poses.append(np.array([x + u[1] * np.cos(a), y + u[1] * np.sin(a), (a + np.pi) % (2 * np.pi) - np.pi]))
     return np.array(poses)
+
+
+def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: int = 32,
+                      learning_rate: float = 1e-2, seed: int = 0):
+    """Emission network trained (with a map of its own, then discarded) on a traversal with known
+    poses, such as a first maze that is not used for evaluation (the paper pretrains its transition
+    this way, Section IV). Returns ``(emission, losses)``."""
+    import jax
+    import jax.numpy as jnp
+
+    from cogmap.inference.elbo import Batch, init_opt_state, init_params, make_optimizer, make_train_step
+
+    poses, scans = jnp.asarray(np.asarray(poses, float))[:, None, :], jnp.asarray(np.asarray(scans, float))
+    params = init_params(cfg, jax.random.PRNGKey(seed))
+    opt = make_optimizer(learning_rate)
+    state = init_opt_state(opt, params)
+    step = make_train_step(cfg, opt, scans.shape[0])
+    rng = np.random.default_rng(seed)
+    losses = []
+    for i in range(iters):
+        idx = rng.integers(0, scans.shape[0], batch)
+        params, state, terms = step(params, state, jax.random.PRNGKey(i), Batch(poses[idx], scans[idx]))
+        losses.append(float(terms.loss))
+    return params.emission, np.array(losses)
 
 
 def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emission=None) -> SLAMResult:
@@ -148,7 +174,8 @@ def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emiss
             idx = np.concatenate([rng.integers(max(0, t + 1 - config.recent_window), t + 1, n_recent),
                                   rng.integers(0, t + 1, config.batch - n_recent)])
             key, k = jax.random.split(key)
-            params, opt_state, terms = train_step(params, opt_state, k, Batch(jnp.asarray(cache[idx]), scans[idx]))
+            new, opt_state, terms = train_step(params, opt_state, k, Batch(jnp.asarray(cache[idx]), scans[idx]))
+            params = new._replace(emission=params.emission) if config.freeze_emission else new
             losses.append(float(terms.loss))
         if progress is not None:
             progress(t)

@@ -15,11 +15,12 @@ def test_slam_run_directory(tmp_path):
     out = tmp_path / "run"
     # a small maze and few training steps keep compile and run time short
     metrics = slam_run(2, 30, out, progress=False, complexity="simple", corridor="medium", train_iters=2,
-                       marginal=False)
+                       marginal=False, pretrain_maze=None)
     for name in ("run.json", "model.npz", "model.json", "trajectory.csv", "metrics.json", "error.png", "map.png"):
         assert (out / name).is_file(), name
     assert json.loads((out / "metrics.json").read_text()) == metrics
-    assert metrics["steps"] == 30 and metrics["training_steps"] == 3 * 2
+    assert metrics["steps"] == 30 and metrics["training_steps"] == 3 * 2 and metrics["pretrain_maze"] is None
+    assert json.loads((out / "run.json").read_text())["config"]["freeze_emission"] is False
     rows = list(csv.DictReader(open(out / "trajectory.csv")))
     assert len(rows) == 30
     true = np.array([[float(r["true_x"]), float(r["true_y"])] for r in rows])
@@ -31,6 +32,11 @@ def test_slam_run_directory(tmp_path):
     data = np.load(out / "model.npz")
     assert np.allclose(np.asarray(params.q_map.mean), data["q_map/mean"])
     assert cfg.map_side == 12 and params.q_map.mean.shape == (12, 12, 20)  # Table II, simple / medium
+
+
+def test_pretraining_maze_must_differ(tmp_path):
+    with pytest.raises(ValueError, match="another maze"):
+        slam_run(0, 10, tmp_path, progress=False, pretrain_maze=0)
 
 
 def test_cli_parses_dvbf_slam():
