@@ -1,5 +1,5 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap drone fly``, ``cogmap reproduce``.
+``cogmap drone fly``, ``cogmap dvbf slam``, ``cogmap reproduce``.
 
 Every error ends the command with one line on stderr naming the problem and exit status 2
 (``--debug`` shows the traceback instead); ``cogmap --version`` prints the version.
@@ -59,6 +59,17 @@ def _drone_fly(args) -> int:
     print(json.dumps({k: (round(v, 4) if isinstance(v, float) else v) for k, v in s.items()}, indent=1))
     if args.out:
         print(f"run written to {args.out}/ (flight.csv, metrics.json, run.json, flight_*_top.png, flight_*_side.png)")
+    return 0
+
+
+def _dvbf(args) -> int:
+    from .dvbf.run import slam_run
+
+    pre = None if args.pretrain_maze < 0 else args.pretrain_maze
+    metrics = slam_run(args.maze, args.steps, Path(args.out), seed=args.seed, progress=not args.quiet,
+                       pretrain_maze=pre)
+    print(json.dumps(metrics, indent=1))
+    print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, error.png, map.png)")
     return 0
 
 
@@ -124,6 +135,19 @@ def build_parser() -> argparse.ArgumentParser:
     f.add_argument("--out", default=None, help="run directory (default: print the summary only)")
     f.add_argument("--quiet", action="store_true")
     f.set_defaults(func=_drone_fly)
+
+    v = sub.add_parser("dvbf", help="DVBF-LM in the LiDAR mazes")
+    vsub = v.add_subparsers(dest="dvbf_command", required=True)
+    ds = vsub.add_parser("slam", help="online SLAM on one seeded maze (unit square), against path integration")
+    ds.add_argument("--maze", type=int, default=1, help="maze seed (default: 1)")
+    ds.add_argument("--pretrain-maze", type=int, default=0,
+                    help="maze whose traversal with known poses pretrains the emission, then frozen "
+                         "(default: 0; -1: learn the emission online from scratch)")
+    ds.add_argument("--steps", type=positive_int, default=1000, help="traversal length (default: 1000)")
+    ds.add_argument("--seed", type=int, default=0, help="traversal, noise and filter seed (default: 0)")
+    ds.add_argument("--out", default="runs/dvbf-slam", help="run directory (default: runs/dvbf-slam)")
+    ds.add_argument("--quiet", action="store_true")
+    ds.set_defaults(func=_dvbf)
 
     from .study.runner import build_parser as study_arguments
 

@@ -7,15 +7,17 @@ pybullet is only imported when a pybullet environment is created.
 from .geometry import Box, Cylinder
 from .gridworld import GridWorld, GridWorldEnv
 from .layouts import LAYOUTS, Layout, make_layout
+from .maze import Maze, exploration_ratio, make_maze
 from .occupancy import OccupancyGrid, layout_grid, rasterise
-from .registry import ALL_IDS, LAYOUT_IDS, register_all
+from .registry import ALL_IDS, LAYOUT_IDS, MAZE_ID, register_all
 from .robot import MoveResult, OdometryNoise
 from .sim import NavSim, SimConfig
 
 register_all()
 
 __all__ = [
-    "ALL_IDS", "LAYOUTS", "LAYOUT_IDS", "Box", "Cylinder", "GridWorld", "GridWorldEnv",
+    "ALL_IDS", "LAYOUTS", "LAYOUT_IDS", "MAZE_ID", "Maze", "exploration_ratio", "make_maze",
+    "Box", "Cylinder", "GridWorld", "GridWorldEnv",
     "Layout", "MoveResult", "NavSim", "OccupancyGrid", "OdometryNoise", "SimConfig",
     "layout_grid", "make_layout", "rasterise", "register_all",
 ]

@@ -17,6 +17,9 @@ LAYOUT_IDS = {
     "cogmap/RandomRooms-v0": "random_rooms",
 }
 GRID_ID = "cogmap/GridWorld-v0"
+#: the DVBF-LM LiDAR maze (continuous controls; not part of ALL_IDS, whose envs share the discrete action set)
+MAZE_ID = "cogmap/LidarMaze-v0"
+MAZE_MAX_STEPS = 3000
 ALL_IDS = (*LAYOUT_IDS, GRID_ID)
 DRONE_ID = "cogmap/DroneField-v0"
 DRONE_MAX_STEPS = 250
@@ -34,3 +37,6 @@ def register_all() -> None:
     if DRONE_ID not in gym.registry:
         gym.register(DRONE_ID, entry_point="cogmap.envs.drone_gym:DroneFieldEnv",
                      max_episode_steps=DRONE_MAX_STEPS)
+    if MAZE_ID not in gym.registry:
+        gym.register(MAZE_ID, entry_point="cogmap.envs.maze_env:LidarMazeEnv",
+                     max_episode_steps=MAZE_MAX_STEPS)

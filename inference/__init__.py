@@ -3,8 +3,8 @@
 Every scheme: ``posterior, info = scheme(model, prior, observations, actions=None, **options)``
 (conventions in :mod:`cogmap.inference.base`). Built-in names: ``exact``, ``filter``
 (:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``, ``kernel``
-(:func:`kernel_filter`, the drone's Gaussian-kernel update over binned factors);
-``get(name)``, ``register(name, fn)``, ``available()``.
+(:func:`kernel_filter`, the drone's Gaussian-kernel update over binned factors), ``particle_filter``
+(continuous states, jax imported on call); ``get(name)``, ``register(name, fn)``, ``available()``.
 """
 
 from .base import (
@@ -22,11 +22,12 @@ from .fpi import fpi
 from .free_energy import window_free_energy
 from .kernel_filter import kernel_filter
 from .message_passing import mmp, vmp
+from .particle_scheme import ParticleModel, particle_filter
 from .pymdp_bridge import to_pymdp
 from .registry import available, get, register, unregister
 
 _BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp),
-            ("kernel", kernel_filter))
+            ("kernel", kernel_filter), ("particle_filter", particle_filter))
 for _name, _fn in _BUILTIN:
     register(_name, _fn)
 
@@ -35,6 +36,7 @@ __all__ = [
     "Evidence",
     "InferenceError",
     "InferenceInfo",
+    "ParticleModel",
     "Problem",
     "available",
     "bayes_filter",
@@ -43,6 +45,7 @@ __all__ = [
     "get",
     "kernel_filter",
     "mmp",
+    "particle_filter",
     "predict_factorised",
     "prepare",
     "register",

@@ -7,7 +7,7 @@ import pytest
 
 DOCS = Path(__file__).resolve().parents[2] / "docs"
 PAGES = ["tutorial-generative-model.md", "quickstart.md", "tutorial-aimapp.md", "plan-and-act.md",
-         "tutorial-drone.md"]
+         "tutorial-drone.md", "tutorial-dvbf.md"]
 
 
 def blocks(page: str) -> list[str]:

@@ -1,0 +1,183 @@
+"""Online SLAM with DVBF-LM (paper Section IV): one pass over a traversal, filtering poses with the
+particle filter under the current map belief while the ELBO trains q(M) and the emission network.
+
+Per step ``t``: the filter resamples, moves its particles through the engineered transition with the
+commanded control and weights them by ``p(x_t | z, M_hat)`` at the map mean ``M_hat``; the resampled
+particles are cached for step ``t`` (the asynchronous particle representation, III-D2). Every
+``train_every`` steps, ``train_iters`` Adam steps on the ELBO (Eq. 3) use random time steps seen so far,
+each with its cached particles. The initial pose is known (the paper's ``rho(z_1)``).
+
+This module is the stateful shell; the mathematics lives in ``genmodel.dvbf``, ``inference.particle_filter``
+and ``inference.elbo``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from cogmap.genmodel.dvbf import DVBFConfig
+
+
+@dataclass(frozen=True)
+class SLAMConfig:
+    """Online-SLAM settings. ``pf_sigma``: per-beam std used to weight particles (the paper's offline
+    filter uses a sharper std than the training emission, Appendix B-I); ``cache``: cached particles
+    per step used by training; ``marginal``: weight particles by the likelihood with the map's
+    uncertainty carried to first order (:func:`~cogmap.genmodel.dvbf.log_likelihood_marginal`) rather
+    than at the map mean alone; ``recent``: share of each training batch drawn from the last
+    ``recent_window`` steps, so the map where the agent is now is learnt before the filter leans on it;
+    ``freeze_emission``: keep the starting emission network fixed and learn only q(M)."""
+
+    n_particles: int = 20
+    pf_sigma: float = 0.05
+    train_every: int = 10
+    train_iters: int = 20
+    batch: int = 32
+    cache: int = 8
+    learning_rate: float = 1e-2
+    init_std: tuple[float, float, float] = (0.001, 0.001, 0.005)
+    model: DVBFConfig = field(default_factory=DVBFConfig)
+    marginal: bool = True
+    recent: float = 0.75
+    recent_window: int = 100
+    freeze_emission: bool = False
+    seed: int = 0
+
+    def to_json(self) -> dict:
+        d = asdict(self)
+        d["model"] = asdict(self.model)
+        return d
+
+
+@dataclass
+class SLAMResult:
+    estimates: np.ndarray  # (T, 3) weighted particle mean per step
+    spreads: np.ndarray  # (T, 3) weighted particle std per step
+    particles: np.ndarray  # (n_particles, 3) at the last step
+    params: object  # DVBFParams after the last training step
+    losses: np.ndarray  # negative ELBO of each training step
+    seconds: float
+
+
+def path_integration(start, controls) -> np.ndarray:
+    """Poses ``(T, 3)`` from dead reckoning with the engineered transition mean (no map)."""
+    poses = [np.asarray(start, float)]
+    for u in np.asarray(controls, float):
+        x, y, a = poses[-1]
+        a = a + u[0]
+        poses.append(np.array([x + u[1] * np.cos(a), y + u[1] * np.sin(a), (a + np.pi) % (2 * np.pi) - np.pi]))
+    return np.array(poses)
+
+
+def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: int = 32,
+                      learning_rate: float = 1e-2, seed: int = 0):
+    """Emission network trained (with a map of its own, then discarded) on a traversal with known
+    poses, such as a first maze that is not used for evaluation (the paper pretrains its transition
+    this way, Section IV). Returns ``(emission, losses)``."""
+    import jax
+    import jax.numpy as jnp
+
+    from cogmap.inference.elbo import Batch, init_opt_state, init_params, make_optimizer, make_train_step
+
+    poses, scans = jnp.asarray(np.asarray(poses, float))[:, None, :], jnp.asarray(np.asarray(scans, float))
+    params = init_params(cfg, jax.random.PRNGKey(seed))
+    opt = make_optimizer(learning_rate)
+    state = init_opt_state(opt, params)
+    step = make_train_step(cfg, opt, scans.shape[0])
+    rng = np.random.default_rng(seed)
+    losses = []
+    for i in range(iters):
+        idx = rng.integers(0, scans.shape[0], batch)
+        params, state, terms = step(params, state, jax.random.PRNGKey(i), Batch(poses[idx], scans[idx]))
+        losses.append(float(terms.loss))
+    return params.emission, np.array(losses)
+
+
+def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emission=None) -> SLAMResult:
+    """Run online SLAM on ``scans (T, n_beams)`` and ``controls (T - 1, 2)`` from the known ``start``.
+
+    ``emission``: an emission network to start from (for example one trained on a first maze, as
+    the paper pretrains its transition); by default a freshly initialised one. The map always starts
+    at the prior.
+    """
+    import equinox as eqx
+    import jax
+    import jax.numpy as jnp
+
+    from cogmap.genmodel.dvbf import log_likelihood, log_likelihood_marginal, transition_sample
+    from cogmap.inference.elbo import Batch, init_opt_state, init_params, make_optimizer, make_train_step
+    from cogmap.inference.particle_filter import pf_init, pf_step, weighted_moments
+
+    cfg = config.model
+    scans = jnp.asarray(np.asarray(scans, float))
+    controls = jnp.asarray(np.asarray(controls, float))
+    T = scans.shape[0]
+    if controls.shape[0] != T - 1:
+        raise ValueError(f"online_slam: {controls.shape[0]} controls for {T} scans (need T - 1)")
+    key = jax.random.PRNGKey(config.seed)
+    key, k_init, k_part = jax.random.split(key, 3)
+    params = init_params(cfg, k_init)
+    if emission is not None:
+        params = params._replace(emission=emission)
+    opt = make_optimizer(config.learning_rate)
+    opt_state = init_opt_state(opt, params)
+    train_step = make_train_step(cfg, opt, T)
+    sigma_t = jnp.asarray(cfg.sigma_t)
+
+    @eqx.filter_jit
+    def filter_chunk(key, state, us, xs, emission, q_map):
+        """``len(us)`` filter steps in one compiled scan; returns cached particles and moments."""
+
+        def lik(z, obs):
+            if config.marginal:
+                return log_likelihood_marginal(emission, q_map, z, obs, cfg, sigma=config.pf_sigma)
+            return log_likelihood(emission, q_map.mean, z, obs, cfg, sigma=config.pf_sigma)
+
+        def trans(k, z, ctrl):
+            return transition_sample(k, z, ctrl, sigma_t)
+
+        def body(s, inp):
+            k, u, x = inp
+            s, _ = pf_step(k, s, u, x, trans, lik)
+            idx = jax.random.choice(jax.random.fold_in(k, 7), s.particles.shape[0], (config.cache,),
+                                    p=jnp.exp(s.log_weights))
+            mean, std = weighted_moments(s)
+            return s, (s.particles[idx], mean, std)
+
+        return jax.lax.scan(body, state, (jax.random.split(key, us.shape[0]), us, xs))
+
+    particles = jnp.asarray(start, float) + jnp.asarray(config.init_std) * jax.random.normal(
+        k_part, (config.n_particles, 3))
+    state = pf_init(particles)
+    cache = np.zeros((T, config.cache, 3), np.float32)
+    cache[0] = np.asarray(particles[: config.cache])
+    estimates, spreads = np.zeros((T, 3)), np.zeros((T, 3))
+    estimates[0] = np.asarray(start, float)
+    spreads[0] = np.asarray(config.init_std)
+    losses = []
+    rng = np.random.default_rng(config.seed)
+    tic = time.perf_counter()
+    t = 0
+    while t < T - 1:
+        n = min(config.train_every, T - 1 - t)
+        key, k = jax.random.split(key)
+        state, (cached, mean, std) = filter_chunk(k, state, controls[t:t + n], scans[t + 1:t + 1 + n],
+                                                  params.emission, params.q_map)
+        cache[t + 1:t + 1 + n] = np.asarray(cached)
+        estimates[t + 1:t + 1 + n], spreads[t + 1:t + 1 + n] = np.asarray(mean), np.asarray(std)
+        t += n
+        for _ in range(config.train_iters):
+            n_recent = int(round(config.recent * config.batch))
+            idx = np.concatenate([rng.integers(max(0, t + 1 - config.recent_window), t + 1, n_recent),
+                                  rng.integers(0, t + 1, config.batch - n_recent)])
+            key, k = jax.random.split(key)
+            new, opt_state, terms = train_step(params, opt_state, k, Batch(jnp.asarray(cache[idx]), scans[idx]))
+            params = new._replace(emission=params.emission) if config.freeze_emission else new
+            losses.append(float(terms.loss))
+        if progress is not None:
+            progress(t)
+    return SLAMResult(estimates, spreads, np.asarray(state.particles), params, np.array(losses),
+                      time.perf_counter() - tic)

@@ -1,0 +1,74 @@
+"""Top-down pictures of a maze, a trajectory and (optionally) LiDAR beams."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .maze import Maze
+
+
+def draw_maze(maze: Maze, ax, paths=(), pose=None, scan=None, particles=None, title: str | None = None):
+    """Draw walls, labelled paths ``[(label, (K, >=2) array, colour)]``, an agent pose with its scan
+    and particles ``(K, >=2)`` on a matplotlib axis."""
+    from matplotlib.patches import Rectangle
+
+    for cx, cy, sx, sy in maze.walls:
+        ax.add_patch(Rectangle((cx - sx / 2, cy - sy / 2), sx, sy, fc="k", ec="none"))
+    for label, path, colour in paths:
+        p = np.asarray(path, float)
+        ax.plot(p[:, 0], p[:, 1], "-", c=colour, lw=0.8, label=label)
+    if particles is not None:
+        q = np.asarray(particles, float)
+        ax.scatter(q[:, 0], q[:, 1], s=6, c="tab:orange", zorder=6)
+    if pose is not None:
+        x, y, a = pose
+        if scan is not None:
+            n = len(scan)
+            ang = a + 2 * np.pi * np.arange(n) / n
+            for r, b in zip(scan, ang, strict=True):
+                ax.plot([x, x + r * np.cos(b)], [y, y + r * np.sin(b)], "-", c="tab:green", lw=0.5)
+        ax.plot(x, y, "o", c="tab:red", ms=4, zorder=7)
+        ax.plot([x, x + 0.05 * maze.size * np.cos(a)], [y, y + 0.05 * maze.size * np.sin(a)], "r-", zorder=7)
+    pad = 0.03 * maze.size
+    ax.set_xlim(-pad, maze.size + pad)
+    ax.set_ylim(-pad, maze.size + pad)
+    ax.set_aspect("equal")
+    if paths:
+        ax.legend(loc="upper right", fontsize=7)
+    ax.set_title(title if title is not None else f"maze {maze.seed} ({maze.complexity}, {maze.corridor})")
+    return ax
+
+
+def save_maze_png(maze: Maze, filename, paths=(), pose=None, scan=None, particles=None,
+                  title: str | None = None, dpi: int = 110) -> str:
+    """Render :func:`draw_maze` to a PNG file (matplotlib Agg); returns the file name."""
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(5, 5))
+    try:
+        draw_maze(maze, ax, paths, pose, scan, particles, title)
+        fig.tight_layout()
+        fig.savefig(filename, dpi=dpi)
+    finally:
+        plt.close(fig)
+    return str(filename)
+
+
+def maze_image(maze: Maze, pose=None, path=None, resolution: int = 200) -> np.ndarray:
+    """Cheap RGB raster (row 0 at the top is max y) of the walls, a path and the agent."""
+    occ = maze.occupancy(resolution)  # [ix, iy]
+    img = np.where(occ[..., None], 30, 240).astype(np.uint8).repeat(3, axis=2)
+
+    def _px(xy):
+        return np.clip((np.asarray(xy, float)[..., :2] / maze.size * resolution).astype(int), 0, resolution - 1)
+
+    if path is not None and len(path):
+        ij = _px(path)
+        img[ij[:, 0], ij[:, 1]] = (200, 40, 40)
+    if pose is not None:
+        i, j = _px(pose)
+        img[max(i - 2, 0):i + 3, max(j - 2, 0):j + 3] = (220, 0, 0)
+    return np.ascontiguousarray(np.transpose(img, (1, 0, 2))[::-1])
