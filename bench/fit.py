@@ -12,21 +12,8 @@ import time
 import numpy as np
 
 from cogmap.genmodel import Factor, Modality, ModelSpec, compile
+from cogmap.genmodel.demo_models import aliased_room
 from cogmap.inference.fit import fit
-
-
-def room(side: int, views: int = 6):
-    moves = [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)]
-    n = side * side
-    B = np.zeros((n, n, 5))
-    for s in range(n):
-        x, y = s % side, s // side
-        for u, (dx, dy) in enumerate(moves):
-            B[min(max(y + dy, 0), side - 1) * side + min(max(x + dx, 0), side - 1), s, u] = 1.0
-    label = np.random.default_rng(7).permutation(np.arange(n) % views)
-    A = np.full((views, n), 0.01)
-    A[label, np.arange(n)] = 1 - 0.01 * (views - 1)
-    return A, B
 
 
 def main(argv=None) -> None:
@@ -36,7 +23,7 @@ def main(argv=None) -> None:
     args = ap.parse_args(argv)
     print(f"{'places':>7} {'us per step and iteration':>27} {'iterations':>11}")
     for side in (4, 5, 10, 20):
-        A, B = room(side)
+        A, B, _ = aliased_room(side, noise=0.05)
         n = side * side
         rng = np.random.default_rng(0)
         s, obs, acts = 0, [], []

@@ -68,4 +68,24 @@ def random_model(rng: np.random.Generator | None = None) -> Model:
     ))
 
 
+ROOM_MOVES = ((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1))  # stay, east, west, north, south
+
+
+def aliased_room(side: int = 4, views: int = 6, noise: float = 0.06, seed: int = 7):
+    """The arrays of a ``side x side`` room where places share ``views`` observations (aliased):
+    ``(A, B, label)`` with ``A`` (views, places) emitting a place's view with probability
+    ``1 - noise`` (the rest spread evenly), ``B`` (places, places, 5) the deterministic moves of
+    ``ROOM_MOVES`` (a wall keeps you in place) and ``label`` each place's view."""
+    n = side * side
+    B = np.zeros((n, n, len(ROOM_MOVES)))
+    for s in range(n):
+        x, y = s % side, s // side
+        for u, (dx, dy) in enumerate(ROOM_MOVES):
+            B[min(max(y + dy, 0), side - 1) * side + min(max(x + dx, 0), side - 1), s, u] = 1.0
+    label = np.random.default_rng(seed).permutation(np.arange(n) % views)
+    A = np.full((views, n), noise / (views - 1))
+    A[label, np.arange(n)] = 1 - noise
+    return A, B, label
+
+
 MODELS = {"tmaze": tmaze, "corridor": corridor, "random": random_model}

@@ -9,20 +9,13 @@ import numpy as np
 import pytest
 
 from cogmap.genmodel import Factor, Modality, ModelSpec, SpecError, compile
+from cogmap.genmodel.demo_models import aliased_room
 from cogmap.inference.fit import _forward_backward, fit, surprise_bits
 
 
 def _room(side=4, views=6, noise=0.05, learn=False, seed=7):
-    moves = [(0, 0), (1, 0), (-1, 0), (0, 1), (0, -1)]
+    A, B, _ = aliased_room(side, views, noise, seed)
     n = side * side
-    B = np.zeros((n, n, 5))
-    for s in range(n):
-        x, y = s % side, s // side
-        for u, (dx, dy) in enumerate(moves):
-            B[min(max(y + dy, 0), side - 1) * side + min(max(x + dx, 0), side - 1), s, u] = 1.0
-    label = np.random.default_rng(seed).permutation(np.arange(n) % views)  # aliased: views < places
-    A = np.full((views, n), noise / (views - 1))
-    A[label, np.arange(n)] = 1 - noise
     spec = ModelSpec([Factor("place", n, num_controls=5)], [Modality("view", views, ("place",))],
                      A={"view": A}, B={"place": np.full((n, n, 5), 1 / n) if learn else B},
                      D={"place": np.full(n, 1 / n)})
