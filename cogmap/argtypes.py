@@ -1,4 +1,4 @@
-"""Argument types of the command line: integers with a lower bound, refused in one line."""
+"""Argument types of the command line: bounded integers and positive numbers, refused in one line."""
 
 from __future__ import annotations
 
@@ -21,6 +21,19 @@ def _bounded_int(minimum: int, what: str):
 
 positive_int = _bounded_int(1, "at least 1")
 nonnegative_int = _bounded_int(0, "at least 0")
+
+
+def positive_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a positive finite number, got {text}")
+    return value
+
+
+positive_float.__name__ = "positive number"
 
 
 class OneLineParser(argparse.ArgumentParser):

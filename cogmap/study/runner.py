@@ -18,12 +18,12 @@ import json
 import os
 import sys
 import time
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from pathlib import Path
 
-from ..argtypes import OneLineParser, positive_int
+from ..argtypes import OneLineParser, positive_float, positive_int
 from .config import STUDIES, run_specs, study_plan
 from .runs import execute
+from .supervisor import run_supervised
 
 
 def write_json_atomic(path: Path, data) -> None:
@@ -52,18 +52,12 @@ def load_runs(study_dir: Path) -> dict[str, dict]:
     return out
 
 
-def _run_local(specs, workers: int, sink) -> None:
-    if workers <= 1:
+def _run_local(specs, workers: int, sink, fail, time_limit: float | None) -> None:
+    if workers <= 1 and time_limit is None:
         for s in specs:
             sink(execute(s))
         return
-    import multiprocessing as mp
-
-    ctx = mp.get_context("spawn")  # pybullet and jax do not like fork
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        futures = [pool.submit(execute, s) for s in specs]
-        for f in as_completed(futures):
-            sink(f.result())
+    run_supervised(execute, specs, workers, time_limit, sink, fail)
 
 
 RAY_MISSING = "the ray executor needs Ray, which is not installed; install it with: pip install 'cogmap[ray]'"
@@ -103,10 +97,13 @@ def _run_ray(specs, workers: int, address: str | None, sink) -> None:
 
 def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None, scale: str = "reduced",
               workers: int = 1, executor: str = "local", address: str | None = None, limit: int | None = None,
-              progress: bool = True, report: bool = True) -> dict:
+              progress: bool = True, report: bool = True, time_limit: float | None = None) -> dict:
     """Run (or resume) study ``name`` under ``out_dir/name``; returns the summary dict.
 
-    ``limit`` runs at most that many of the missing runs (then stops, as if interrupted)."""
+    ``limit`` runs at most that many of the missing runs (then stops, as if interrupted).
+    ``time_limit`` (seconds, local executor) runs every run in a worker process that is killed
+    past the limit: the run is recorded in ``failed/<key>.json`` with its reason, the study goes
+    on, and a later session retries it. Without it and with one worker, runs go in-process."""
     from tqdm import tqdm
 
     from cogmap.runs import git_commit, versions
@@ -129,16 +126,25 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     bar = tqdm(total=len(specs), initial=len(specs) - missing,
                disable=not progress, desc=f"{name} runs", unit="run")
 
+    failed: dict[str, str] = {}
+
     def sink(res):
         write_json_atomic(runs_dir / f"{res['key']}.json", res)
+        (study_dir / "failed" / f"{res['key']}.json").unlink(missing_ok=True)
         done[res["key"]] = res
         bar.update(1)
         bar.set_postfix_str(res["key"])
 
+    def fail(spec, reason):
+        write_json_atomic(study_dir / "failed" / f"{spec['key']}.json", {"key": spec["key"], "spec": spec,
+                                                                          "reason": reason})
+        failed[spec["key"]] = reason
+        bar.write(f"run {spec['key']} failed: {reason}")
+
     try:
         if todo:
             if executor == "local":
-                _run_local(todo, workers, sink)
+                _run_local(todo, workers, sink, fail, time_limit)
             elif executor == "ray":
                 _run_ray(todo, workers, address, sink)
             else:
@@ -157,14 +163,15 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
         "complete": complete, "executor": executor, "workers": workers,
         "versions": versions(), "commit": git_commit(),
         "sessions": prev.get("sessions", []) + [{"ran": len(todo), "wall_s": round(elapsed, 1), "executor": executor,
-                                                 "workers": workers}],
+                                                 "workers": workers, "time_limit_s": time_limit,
+                                                 "failed": failed}],
         "run_wall_s_total": round(sum(r.get("wall_s", 0.0) for r in results), 1),
         "code_digests": sorted({r["code"] for r in results if r.get("code")}),
     }
     meta["wall_s_total"] = round(sum(s["wall_s"] for s in meta["sessions"]), 1)
     write_json_atomic(meta_path, meta)
     summary = {"study_dir": str(study_dir), "complete": complete, "runs": len(results), "total": len(specs),
-               "wall_s": elapsed}
+               "wall_s": elapsed, "failed": failed}
     from .report import distinct_check
 
     summary["duplicates"] = distinct_check(results)[1]
@@ -189,6 +196,9 @@ def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.Argu
     p.add_argument("--envs", nargs="*", default=None)
     p.add_argument("--methods", nargs="*", default=None)
     p.add_argument("--limit", type=positive_int, default=None, help="run at most this many missing runs")
+    p.add_argument("--time-limit", type=positive_float, default=1800.0,
+                   help="wall-clock seconds per run (local executor) before it is stopped and recorded as "
+                        "failed (default: 1800)")
     p.add_argument("--quiet", action="store_true")
     return p
 
@@ -196,11 +206,14 @@ def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.Argu
 def run_from_args(args) -> int:
     summary = run_study(args.study, args.out, seeds=args.seeds, envs=args.envs, methods=args.methods,
                         scale=args.scale, workers=args.workers, executor=args.executor, address=args.address,
-                        limit=args.limit, progress=not args.quiet)
+                        limit=args.limit, progress=not args.quiet,
+                        time_limit=args.time_limit if args.executor == "local" else None)
     if summary.get("table"):
         print(summary["table"])
     print(f"{summary['runs']}/{summary['total']} runs in {summary['study_dir']} "
           f"({summary['wall_s']:.0f} s this session)")
+    if summary["failed"]:
+        print(f"{len(summary['failed'])} runs failed (reasons in failed/*.json; a new session retries them)")
     if summary["duplicates"]:
         return 4
     return 0 if summary["complete"] else 3

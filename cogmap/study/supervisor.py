@@ -1,0 +1,93 @@
+"""Worker processes with a wall-clock limit per run.
+
+``workers`` long-lived child processes (spawned: pybullet and jax do not like fork) take run
+specs from a task queue and report each result. The parent watches how long every worker has
+been on its current run: past ``time_limit`` seconds the worker is killed (a hung native call,
+such as a renderer that never returns, cannot be interrupted from inside), the run is reported as
+failed with the reason, and a fresh worker takes its place. A worker that dies on its own is
+reported the same way. Nothing else waits on a stuck run, so a study always finishes.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import queue as queue_mod
+import time
+import traceback
+from collections.abc import Callable
+
+POLL_S = 0.1
+
+
+def _worker(fn, tasks, results) -> None:
+    while True:
+        item = tasks.get()
+        if item is None:
+            return
+        index, spec = item
+        results.put(("start", index, os.getpid()))
+        try:
+            results.put(("done", index, fn(spec)))
+        except Exception as err:  # the run fails; the worker goes on with the next one
+            line = traceback.format_exception_only(type(err), err)[-1].strip()
+            results.put(("error", index, line))
+
+
+def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, time_limit: float | None,
+                   sink: Callable[[dict], None], fail: Callable[[dict, str], None]) -> None:
+    """Run ``fn(spec)`` for every spec in ``workers`` processes; ``sink(result)`` for each finished
+    run, ``fail(spec, reason)`` for one that raised, died or exceeded ``time_limit`` seconds."""
+    ctx = mp.get_context("spawn")
+    tasks, results = ctx.Queue(), ctx.Queue()
+    for item in enumerate(specs):
+        tasks.put(item)
+    procs: list = []
+
+    def spawn():
+        p = ctx.Process(target=_worker, args=(fn, tasks, results), daemon=True)
+        p.start()
+        procs.append(p)
+        return p
+
+    for _ in range(max(1, min(workers, len(specs)))):
+        spawn()
+    started: dict[int, float] = {}  # run index -> start time (monotonic)
+    owner: dict[int, int] = {}  # run index -> pid of the worker running it
+    finished = 0
+    try:
+        while finished < len(specs):
+            try:
+                kind, index, payload = results.get(timeout=POLL_S)
+            except queue_mod.Empty:
+                kind = None
+            if kind == "start":
+                started[index], owner[index] = time.monotonic(), payload
+            elif kind in ("done", "error"):
+                started.pop(index, None)
+                owner.pop(index, None)
+                finished += 1
+                sink(payload) if kind == "done" else fail(specs[index], payload)
+            now = time.monotonic()
+            for index, t0 in list(started.items()):
+                proc = next((p for p in procs if p.pid == owner[index]), None)
+                over = time_limit is not None and now - t0 > time_limit
+                dead = proc is None or not proc.is_alive()  # workers only exit when killed or crashed
+                if not (over or dead):
+                    continue
+                reason = (f"exceeded the time limit of {time_limit:g} s" if over
+                          else f"its worker process died (exit code {None if proc is None else proc.exitcode})")
+                if proc is not None:
+                    proc.kill()
+                    proc.join()
+                    procs.remove(proc)
+                del started[index], owner[index]
+                finished += 1
+                fail(specs[index], reason)
+                if finished + len(started) < len(specs):
+                    spawn()
+    finally:
+        for p in procs:
+            if p.is_alive():
+                p.kill()
+            p.join()
