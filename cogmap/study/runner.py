@@ -14,6 +14,8 @@ Executors: ``local`` (``ProcessPoolExecutor``; ``workers=1`` runs in-process) or
 from __future__ import annotations
 
 import argparse
+import contextlib
+import fcntl
 import json
 import os
 import sys
@@ -104,10 +106,6 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     ``time_limit`` (seconds, local executor) runs every run in a worker process that is killed
     past the limit: the run is recorded in ``failed/<key>.json`` with its reason, the study goes
     on, and a later session retries it. Without it and with one worker, runs go in-process."""
-    from tqdm import tqdm
-
-    from cogmap.runs import git_commit, versions
-
     if executor == "ray":
         require_ray()  # before any directory is made
     plan = study_plan(name, scale, envs=envs, seeds=seeds, methods=methods)
@@ -115,6 +113,37 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     study_dir = Path(out_dir) / name
     runs_dir = study_dir / "runs"
     runs_dir.mkdir(parents=True, exist_ok=True)
+    with _locked(study_dir):
+        return _run_study(name, study_dir, runs_dir, plan, specs, workers, executor, address, limit, progress,
+                          report, time_limit)
+
+
+class StudyBusyError(RuntimeError):
+    """Another process is running a study in this directory."""
+
+
+@contextlib.contextmanager
+def _locked(study_dir: Path):
+    """An exclusive lock on ``study_dir/.lock`` for the whole session (released when the process
+    ends, however it ends), so two studies never write one directory."""
+    fh = open(study_dir / ".lock", "a+")
+    try:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise StudyBusyError(f"{study_dir} is in use by another study; wait for it to finish "
+                                 "or choose another --out") from None
+        yield
+    finally:
+        fh.close()
+
+
+def _run_study(name, study_dir, runs_dir, plan, specs, workers, executor, address, limit, progress, report,
+               time_limit) -> dict:
+    from tqdm import tqdm
+
+    from cogmap.runs import git_commit, versions
+
     stored = load_runs(study_dir)  # files of other scales or settings stay, but are never used here
     done = {s["key"]: stored[s["key"]] for s in specs
             if s["key"] in stored and same_spec(stored[s["key"]].get("spec"), s)}

@@ -5,7 +5,9 @@ specs from a task queue and report each result. The parent watches how long ever
 been on its current run: past ``time_limit`` seconds the worker is killed (a hung native call,
 such as a renderer that never returns, cannot be interrupted from inside), the run is reported as
 failed with the reason, and a fresh worker takes its place. A worker that dies on its own is
-reported the same way. Nothing else waits on a stuck run, so a study always finishes.
+reported the same way. Nothing else waits on a stuck run, so a study always finishes. Workers
+ignore Ctrl-C; the parent stops them all on any exit, Ctrl-C included (finished runs are already
+written).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import queue as queue_mod
+import signal
 import time
 import traceback
 from collections.abc import Callable
@@ -21,6 +24,7 @@ POLL_S = 0.1
 
 
 def _worker(fn, tasks, results) -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops the workers
     while True:
         item = tasks.get()
         if item is None:
@@ -91,3 +95,6 @@ def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, 
             if p.is_alive():
                 p.kill()
             p.join()
+        for q in (tasks, results):  # release the queues' pipes and semaphores now, not at exit
+            q.cancel_join_thread()
+            q.close()

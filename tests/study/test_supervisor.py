@@ -34,3 +34,50 @@ def test_a_run_that_raises_is_recorded_with_its_error():
     run_supervised(int, specs, 1, 30.0, done.append, lambda spec, why: failed.append((spec["key"], why)))
     assert not done and [k for k, _ in failed] == ["a", "b"]
     assert all("TypeError" in why for _, why in failed)  # int(dict) raises in the worker, which goes on
+
+
+def test_two_studies_cannot_write_one_directory(tmp_path):
+    import fcntl
+
+    from cogmap.study.runner import StudyBusyError
+
+    (tmp_path / "exploration").mkdir()
+    with open(tmp_path / "exploration" / ".lock", "a+") as held:  # another process holds the study
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(StudyBusyError, match="in use by another study"):
+            run_study("exploration", tmp_path, scale="tiny", seeds=[0], envs=["mini_warehouse"],
+                      methods=["random"], progress=False)
+
+
+def test_ctrl_c_stops_a_study_quickly_keeps_finished_runs_and_leaves_no_process(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    cmd = [sys.executable, "-m", "cogmap.cli", "reproduce", "exploration", "--scale", "tiny", "--out",
+           str(tmp_path), "--workers", "2", "--quiet"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    runs = tmp_path / "exploration" / "runs"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not (runs.exists() and any(runs.glob("*.json"))):
+        time.sleep(0.2)
+    kept_before = len(list(runs.glob("*.json")))
+    assert kept_before >= 1 and proc.poll() is None, "the study should still be running"
+    t0 = time.monotonic()
+    os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C reaches the whole foreground group
+    _, err = proc.communicate(timeout=30)
+    assert time.monotonic() - t0 < 10
+    assert proc.returncode == 130 and "interrupted" in err and "Traceback" not in err
+    assert len(list(runs.glob("*.json"))) >= kept_before  # finished runs are kept
+    deadline = time.monotonic() + 15  # no worker left behind (an exited helper is reaped by init)
+    while time.monotonic() < deadline:
+        try:
+            os.killpg(proc.pid, 0)
+        except ProcessLookupError:
+            break
+        time.sleep(0.2)
+    else:
+        pytest.fail("processes of the study are still running 15 s after Ctrl-C")
