@@ -71,7 +71,10 @@ def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, 
                 started.pop(index, None)
                 owner.pop(index, None)
                 finished += 1
-                sink(payload) if kind == "done" else fail(specs[index], payload)
+                if kind == "done":
+                    sink(payload)
+                else:
+                    fail(specs[index], payload)
             now = time.monotonic()
             for index, t0 in list(started.items()):
                 proc = next((p for p in procs if p.pid == owner[index]), None)
@@ -90,6 +93,8 @@ def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, 
                 fail(specs[index], reason)
                 if finished + len(started) < len(specs):
                     spawn()
+            if finished < len(specs) and not any(p.is_alive() for p in procs):
+                spawn()  # never wait on runs with no worker left to take them
     finally:
         for p in procs:
             if p.is_alive():
