@@ -27,12 +27,12 @@ from cogmap import inference
 from cogmap.genmodel import Model, SpecError
 from cogmap.inference.learning import learn_observation
 from cogmap.planning import efe
+from cogmap.planning.decide import MODES, make_objective
 from cogmap.planning.decide import decide as mcts_decide
 from cogmap.planning.mcts import MCTSConfig
 from cogmap.planning.policies import infer_policies
 
 PLANNERS = ("enumerate", "mcts")
-OBJECTIVES = {"pymdp": efe.pymdp_like, "explore": efe.exploration, "goal": efe.goal, "full": efe.full}
 
 
 class LoopConfig(NamedTuple):
@@ -87,8 +87,9 @@ def init(
     **scheme_options,
 ) -> LoopState:
     """A fresh agent on ``model``: the prior is ``D``. ``objective`` is an
-    :class:`~cogmap.planning.efe.Objective` or one of "pymdp" (utility + state information gain,
-    pymdp's default ``neg_efe``; the default), "explore", "goal", "full"; ``scheme_options``
+    :class:`~cogmap.planning.efe.Objective` or a name of ``planning.decide.MODES``: "pymdp" (utility
+    + state information gain, pymdp's default ``neg_efe``; the default), "explore", "goal", "full",
+    "sensed"; ``scheme_options``
     go to the inference scheme (e.g. ``num_iter=16``)."""
     if not isinstance(model, Model):
         raise TypeError(f"init needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")
@@ -100,9 +101,9 @@ def init(
     if not (np.isfinite(gamma) and gamma > 0):
         raise ValueError(f"gamma (policy precision) must be positive and finite, got {gamma!r}")
     if isinstance(objective, str):
-        if objective not in OBJECTIVES:
-            raise ValueError(f"unknown objective '{objective}' (known: {', '.join(OBJECTIVES)} or an Objective)")
-        objective = OBJECTIVES[objective]()
+        if objective not in MODES:
+            raise ValueError(f"unknown objective '{objective}' (known: {', '.join(MODES)} or an Objective)")
+        objective = make_objective(objective)
     if learn_A and not all(model.has_counts_A(m) for m in range(len(model.modalities))):
         raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")
     if learn_B and any(model.B[f].counts is None or model.is_sparse(f) for f in range(len(model.factors))):

@@ -3,9 +3,19 @@
 from __future__ import annotations
 
 import numpy as np
+from scipy.special import digamma
 
-from .numerics import normalise
+from .numerics import LOG_FLOOR, normalise
 from .spec import SpecError
+
+
+def novelty(a: np.ndarray, a0: np.ndarray) -> np.ndarray:
+    """Parameter information-gain weight of Dirichlet entries ``a`` in columns of total ``a0``:
+    ``W = ln a0 - ln a + psi(a + 1) - psi(a0 + 1)`` (Da Costa et al. 2020, D.15), both floored
+    at the log floor."""
+    a = np.maximum(a, LOG_FLOOR)
+    a0 = np.maximum(a0, LOG_FLOOR)
+    return np.log(a0) - np.log(a) + digamma(a + 1.0) - digamma(a0 + 1.0)
 
 
 def update_pA(pA: np.ndarray, obs, qs: list[np.ndarray], lr: float = 1.0, floor: float = 1e-3) -> np.ndarray:

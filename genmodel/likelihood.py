@@ -30,25 +30,15 @@ states that learned it.
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import digamma
 
 from .capacity import pad_axis
 from .dirichlet import as_distribution, normalise_counts, update_pA
+from .dirichlet import novelty as dirichlet_novelty
 from .numerics import LOG_FLOOR, xlogx
 from .spec import SpecError
 
 EPS = LOG_FLOOR  # the shared log floor (cogmap.genmodel.numerics)
 SUPPORT_CUTOFF = 1e-12  # belief mass below which a learning update leaves a column alone
-
-
-_xlogx = xlogx
-
-
-def _novelty(a: np.ndarray, a0: np.ndarray) -> np.ndarray:
-    """Parameter information-gain weight of a Dirichlet entry (see ``planning.efe.novelty_weights``)."""
-    a = np.maximum(a, EPS)
-    a0 = np.maximum(a0, EPS)
-    return np.log(a0) - np.log(a) + digamma(a + 1.0) - digamma(a0 + 1.0)
 
 
 class DenseLikelihood:
@@ -165,12 +155,12 @@ class DenseLikelihood:
         """As :meth:`SparseLikelihood.column_stats`, with every outcome a "slot"."""
         states = np.asarray(states, dtype=np.int64)
         cols = self.prob[: self.num_obs, states]
-        H = -_xlogx(cols).sum(axis=0)
+        H = -xlogx(cols).sum(axis=0)
         zero = np.zeros(states.size)
         if not novelty or self.counts is None:
             return H, zero, np.zeros((states.size, self.num_obs))
         a = self.counts[: self.num_obs, states]
-        w = np.where(a > 0, _novelty(a, a.sum(axis=0, keepdims=True)), 0.0)
+        w = np.where(a > 0, dirichlet_novelty(a, a.sum(axis=0, keepdims=True)), 0.0)
         return H, zero, w.T
 
     def mixture(self, states: np.ndarray, qs: np.ndarray):
@@ -396,11 +386,11 @@ class SparseLikelihood:
         valid = self.obs[states] >= 0
         a = bg[:, None] + self.cnt[states]
         k = valid.sum(axis=1)
-        H = -((n_o - k) * _xlogx(bg / T) + np.where(valid, _xlogx(a / T[:, None]), 0.0).sum(axis=1))
+        H = -((n_o - k) * xlogx(bg / T) + np.where(valid, xlogx(a / T[:, None]), 0.0).sum(axis=1))
         if not novelty:
             return H, np.zeros_like(H), np.zeros(a.shape)
-        w_bg = np.where(bg > 0, _novelty(bg, T), 0.0)
-        w_slots = np.where(valid, _novelty(a, T[:, None]), 0.0)
+        w_bg = np.where(bg > 0, dirichlet_novelty(bg, T), 0.0)
+        w_slots = np.where(valid, dirichlet_novelty(a, T[:, None]), 0.0)
         return H, w_bg, w_slots
 
     def mixture(self, states: np.ndarray, qs: np.ndarray):

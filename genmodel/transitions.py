@@ -46,6 +46,10 @@ class DenseTransitions:
         n = self.capacity if n is None else n
         return self.prob[:n, :n]
 
+    def control_dense(self, u: int, n: int) -> np.ndarray:
+        """The live ``B[:, :, u]`` (next, current) block (a view)."""
+        return self.prob[:n, :n, u]
+
     def counts_dense(self, n: int | None = None) -> np.ndarray | None:
         n = self.capacity if n is None else n
         return None if self.counts is None else self.counts[:n, :n]
@@ -166,11 +170,12 @@ class SparseTransitions:
     def to_dense(self, n: int | None = None) -> np.ndarray:
         """Dense ``(n, n, u)`` copy of the first ``n`` states (tests, pymdp export)."""
         n = self.capacity if n is None else n
-        u = self.num_controls
-        out = np.zeros((n, n, u))
-        for a in range(u):
-            s_idx = np.repeat(np.arange(n), self.slots)
-            np.add.at(out[:, :, a], (self.succ[:n, a].ravel(), s_idx), self.prob[:n, a].ravel())
+        return np.stack([self.control_dense(a, n) for a in range(self.num_controls)], axis=2)
+
+    def control_dense(self, u: int, n: int) -> np.ndarray:
+        """Dense ``(n, n)`` ``B[:, :, u]`` (next, current) of the first ``n`` states."""
+        out = np.zeros((n, n))
+        np.add.at(out, (self.succ[:n, u].ravel(), np.repeat(np.arange(n), self.slots)), self.prob[:n, u].ravel())
         return out
 
     def counts_dense(self, n: int | None = None) -> np.ndarray:

@@ -281,14 +281,8 @@ def prepare(model, prior, observations, actions=None) -> Problem:
 
 
 def dense_transition(model, f: int, u: int) -> np.ndarray:
-    """Live dense ``B[f][:, :, u]`` (``(next, current)``) for dense or sparse storage."""
-    n = model.num_states[f]
-    B = model.B[f]
-    if model.is_sparse(f):  # only control u, not the whole dense copy
-        out = np.zeros((n, n))
-        np.add.at(out, (B.succ[:n, u].ravel(), np.repeat(np.arange(n), B.slots)), B.prob[:n, u].ravel())
-        return out
-    return B.to_dense(n)[:, :, u]
+    """Live dense ``B[f][:, :, u]`` (``(next, current)``), whatever the storage."""
+    return model.B[f].control_dense(u, model.num_states[f])
 
 
 def marginal_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs, f: int) -> np.ndarray:

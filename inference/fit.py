@@ -30,6 +30,8 @@ from scipy.special import digamma, gammaln
 from cogmap.genmodel.numerics import TINY_FLOOR, floor_log
 from cogmap.genmodel.spec import SpecError
 
+from .bayes_filter import bayes_filter
+
 
 class FitResult(NamedTuple):
     free_energy: list  # F after the smoothing step of each iteration (nats), non-increasing
@@ -149,18 +151,7 @@ def fit(model, sequences: Sequence, *, learn_A: bool = True, learn_B: bool = Tru
 
 def surprise_bits(model, observations, actions) -> float:
     """Mean predictive surprise ``-log2 p(o_t | o_<t, u_<t)`` per step under the model's
-    expected parameters (one factor, dense)."""
-    obs = np.asarray(observations, dtype=np.int64).reshape(len(observations), len(model.modalities))
-    acts = np.asarray(actions, dtype=np.int64).reshape(-1)
-    A = [model.live_A(m) for m in range(len(model.modalities))]
-    B = model.live_B(0)
-    q = model.live_D(0).copy()
-    total = 0.0
-    for t in range(len(obs)):
-        if t:
-            q = B[:, :, acts[t - 1]] @ q
-        lik = np.prod([A[m][obs[t, m]] for m in range(len(A))], axis=0)
-        p = float(lik @ q)
-        total -= np.log2(max(p, 1e-300))
-        q = lik * q / max(p, 1e-300)
-    return total / len(obs)
+    expected parameters (one factor): the exact filter's ``-log p(o_1:T)`` over ``T ln 2``."""
+    actions = [(int(a),) for a in np.asarray(actions, dtype=np.int64).reshape(-1)]
+    _, info = bayes_filter(model, [model.live_D(0)], [list(o) for o in observations], actions)
+    return info.total_free_energy / (len(observations) * np.log(2.0))

@@ -19,21 +19,31 @@ import numpy as np
 from .base import dense_transition, expected_loglik, floor_log, prepare, xlogx_sum
 
 
+def free_energy_terms(model, prob, prior, marginals, start: int = 0) -> np.ndarray:
+    """Per-step terms of ``F[q]`` for the steps ``start..T-1`` of the checked problem ``prob``,
+    with ``prior[f]`` the belief at ``start`` and ``marginals[k][f]`` the marginal of step
+    ``start + k``: entropy, transition (prior at the first step) and likelihood terms of the step."""
+    T = prob.T - start
+    terms = np.zeros(T)
+    for k in range(T):
+        q_k = [np.asarray(q, dtype=float) for q in marginals[k]]
+        fe = 0.0
+        for f in range(prob.num_factors):
+            fe += xlogx_sum(q_k[f])
+            if k == 0:
+                fe -= float(q_k[f] @ floor_log(prior[f]))
+            else:
+                logB = floor_log(dense_transition(model, f, prob.actions[start + k - 1][f]))
+                fe -= float(q_k[f] @ logB @ np.asarray(marginals[k - 1][f], dtype=float))
+        for ev in prob.evidence[start + k]:
+            fe -= expected_loglik(floor_log(ev.lik), ev.deps, q_k) + ev.log_scale
+        terms[k] = fe
+    return terms
+
+
 def window_free_energy(model, prior, observations, actions, marginals) -> float:
     """``F[q]`` above for ``marginals[t][f]`` (live sizes) over the whole ``observations``."""
     prob = prepare(model, prior, observations, actions)
     if len(marginals) != prob.T:
         raise ValueError(f"marginals cover {len(marginals)} steps, the observations {prob.T}")
-    fe = 0.0
-    for t in range(prob.T):
-        q_t = [np.asarray(q, dtype=float) for q in marginals[t]]
-        for f in range(prob.num_factors):
-            fe += xlogx_sum(q_t[f])
-            if t == 0:
-                fe -= float(q_t[f] @ floor_log(prob.prior[f]))
-            else:
-                logB = floor_log(dense_transition(model, f, prob.actions[t - 1][f]))
-                fe -= float(q_t[f] @ logB @ np.asarray(marginals[t - 1][f], dtype=float))
-        for ev in prob.evidence[t]:
-            fe -= expected_loglik(floor_log(ev.lik), ev.deps, q_t) + ev.log_scale
-    return fe
+    return float(free_energy_terms(model, prob, prob.prior, marginals).sum())

@@ -29,15 +29,14 @@ from .base import (
     InferenceInfo,
     check_num_iter,
     dense_transition,
-    expected_loglik,
     floor_log,
     marginal_loglik,
     predict_factorised,
     prepare,
     softmax,
-    xlogx_sum,
 )
 from .fpi import fpi_step
+from .free_energy import free_energy_terms
 
 
 def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
@@ -77,17 +76,7 @@ def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
             new.append(row)
         qs = new
     # mean-field free energy of the window, split so the last step's terms can be reported
-    terms = np.zeros(T)
-    for t in range(T):
-        fe = 0.0
-        for f in range(F):
-            q = qs[t][f]
-            fe += xlogx_sum(q)
-            fe -= float(q @ log_prior[f]) if t == 0 else float(q @ logB[t - 1][f] @ qs[t - 1][f])
-        for deps, ll, scale in logliks[t]:
-            fe -= expected_loglik(ll, deps, qs[t]) + scale
-        terms[t] = fe
-    return qs, terms
+    return qs, free_energy_terms(model, prob, prior, qs, start)
 
 
 def _window_scheme(kind: str):

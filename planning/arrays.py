@@ -162,7 +162,7 @@ class Prepared:
     wB: list = field(default_factory=list)  # dense: novelty weights per factor (or None)
     dist: np.ndarray | None = None  # goal distances of goal_factor (None: no goal)
     need_novelty: bool = True
-    _cache: dict = field(default_factory=dict)  # local path, dense likelihoods: state -> column stats
+    _cache: dict = field(default_factory=dict)  # local path, dense likelihoods: modality -> _Columns
 
     def column_stats(self, m: int, U: np.ndarray):
         """``(H, w_bg, w_slots)`` of likelihood ``m`` at states ``U`` (see
@@ -172,16 +172,40 @@ class Prepared:
         novelty = self.need_novelty and A.has_counts
         if isinstance(A, SparseLikelihood):
             return A.column_stats(U, novelty)
-        cache = self._cache.setdefault(m, {})
-        new = np.array([s for s in np.unique(U).tolist() if s not in cache], dtype=np.int64)
+        cache = self._cache.get(m)
+        if cache is None:
+            cache = self._cache[m] = _Columns(np.full(max(A.num_states[0], 1), -1, dtype=np.int64))
+        return cache.get(A, np.asarray(U, dtype=np.int64), novelty)
+
+
+@dataclass
+class _Columns:
+    """Column statistics of a dense likelihood, computed once per state and decision."""
+
+    slot: np.ndarray  # state -> row of the arrays below (-1: not computed)
+    H: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    w_bg: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    w_slots: np.ndarray | None = None
+    used: int = 0
+
+    def get(self, A, U: np.ndarray, novelty: bool):
+        new = np.unique(U[self.slot[U] < 0])
         if new.size:
             H, w_bg, w_slots = A.column_stats(new, novelty)
-            for i, s in enumerate(new.tolist()):
-                cache[s] = (H[i], w_bg[i], w_slots[i])
-        rows = [cache[s] for s in U.tolist()]
-        return (np.array([r[0] for r in rows]), np.array([r[1] for r in rows]),
-                np.array([r[2] for r in rows]).reshape(len(rows), -1))
-
+            rows = np.arange(self.used, self.used + new.size)
+            if self.used + new.size > self.H.size:  # double the room
+                cap = max(64, 2 * (self.used + new.size))
+                self.H = np.resize(self.H, cap)
+                self.w_bg = np.resize(self.w_bg, cap)
+                grown = np.zeros((cap, w_slots.shape[1]))
+                if self.w_slots is not None:
+                    grown[: self.used] = self.w_slots[: self.used]
+                self.w_slots = grown
+            self.H[rows], self.w_bg[rows], self.w_slots[rows] = H, w_bg, w_slots
+            self.slot[new] = rows
+            self.used += new.size
+        idx = self.slot[U]
+        return self.H[idx], self.w_bg[idx], self.w_slots[idx]
 
 def prepare(
     arrays: PlanningArrays,

@@ -11,7 +11,8 @@ from .arrays import PlanningArrays, from_model, prepare
 from .mcts import Decision, MCTSConfig, mcts
 from .threads import limited
 
-MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full, "sensed": efe.sensed_exploration}
+MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full, "sensed": efe.sensed_exploration,
+         "pymdp": efe.pymdp_like}
 
 
 def make_objective(mode, inductive_weight: float | None = None) -> efe.Objective:

@@ -17,8 +17,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import digamma
 
+from cogmap.genmodel.dirichlet import novelty
 from cogmap.genmodel.numerics import LOG_FLOOR, xlogx
 
 EPS = LOG_FLOOR  # the shared log floor (cogmap.genmodel.numerics)
@@ -41,9 +41,7 @@ def novelty_weights(counts: np.ndarray, axis: int = 0) -> np.ndarray:
     column's outcome and its conditioning states.
     """
     a = np.maximum(counts, EPS)
-    a0 = np.maximum(a.sum(axis=axis, keepdims=True), EPS)
-    w = np.log(a0) - np.log(a) + digamma(a + 1.0) - digamma(a0 + 1.0)
-    return np.where(counts > 0, w, 0.0)
+    return np.where(counts > 0, novelty(a, a.sum(axis=axis, keepdims=True)), 0.0)
 
 
 # -- the six terms of Eq. 6 (plus the inductive term of Eq. 9) ------------------------------
