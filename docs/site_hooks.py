@@ -4,7 +4,9 @@ The libraries live in top-level folders (``genmodel/``, ``inference/``, ...) tha
 ``cogmap.genmodel`` and so on (``[tool.setuptools.package-dir]``). mkdocstrings reads sources
 statically by import path, so before the build :func:`build_tree` assembles ``.api/cogmap/`` as a
 copy of ``cogmap/`` with each library folder copied in under its import name (links would be
-resolved back to the real folders). Nothing is imported.
+resolved back to the real folders), and rewrites the reStructuredText roles of the docstrings
+(``:func:`name```, ``:class:`~a.B```, a paragraph ending in ``::``) as Markdown code, since
+mkdocstrings renders docstrings as Markdown. Nothing is imported.
 
 The API pages are generated: one per package, one section per public module (every ``*.py`` not
 starting with an underscore), so a new module is documented without editing a page.
@@ -12,6 +14,7 @@ starting with an underscore), so a new module is documented without editing a pa
 
 from __future__ import annotations
 
+import re
 import shutil
 from pathlib import Path
 
@@ -32,6 +35,15 @@ API = {
 }
 
 
+ROLE = re.compile(r":(?:func|class|mod|meth|data|attr|obj|exc|const):`~?\.?([^`]+)`")
+LITERAL = re.compile(r"(?<=[\w)`]):: *$", flags=re.M)
+
+
+def markdown_roles(text: str) -> str:
+    """``:func:`a.b``` -> ```a.b```, and a paragraph's closing ``::`` -> ``:``."""
+    return LITERAL.sub(":", ROLE.sub(r"`\1`", text))
+
+
 def build_tree(root: Path = ROOT) -> Path:
     """Create ``root/.api/cogmap`` (a copy of the sources under their import names) and return
     ``root/.api``."""
@@ -42,6 +54,8 @@ def build_tree(root: Path = ROOT) -> Path:
     shutil.copytree(root / "cogmap", api / "cogmap", ignore=skip)
     for name in LIBRARIES:
         shutil.copytree(root / name, api / "cogmap" / name, ignore=skip)
+    for path in api.rglob("*.py"):
+        path.write_text(markdown_roles(path.read_text()))
     return api
 
 
