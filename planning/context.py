@@ -91,7 +91,24 @@ class _Common:
 
 
 class DenseStep(_Common):
-    """One step from batched beliefs ``qs_prev`` (per factor (K, n_f)) under ``actions`` (K, F)."""
+    """One planning step from batched beliefs ``qs_prev`` under ``actions``, on full (multi-factor) beliefs.
+
+    Predicted beliefs ``qs`` are computed on construction; the other attributes listed in the module
+    docstring are computed on first access.
+
+    Parameters
+    ----------
+    prep : Prepared
+        Derived arrays of the decision (dense path).
+    qs_prev : list of numpy.ndarray
+        Per factor, ``(K, n_f)`` float beliefs before the step, rows sum to 1.
+    actions : numpy.ndarray
+        ``(K, F)`` int, one control per factor for each candidate.
+    t : int, optional
+        Index of the step within the imagined policy, default 0.
+    collision : numpy.ndarray or None, optional
+        ``(K,)`` float probability of a collision per candidate (first step only), or None.
+    """
 
     def __init__(self, prep: Prepared, qs_prev: list, actions: np.ndarray, t: int = 0, collision=None):
         self.prep = prep
@@ -158,6 +175,7 @@ class DenseStep(_Common):
 
     @property
     def C_states(self) -> list:
+        """Per factor, the ``(n_f,)`` float log-preferences over live states (None entries without any)."""
         a = self._a
         if a.C_states is None:
             return [None] * a.num_factors
@@ -165,6 +183,7 @@ class DenseStep(_Common):
 
     @property
     def poses(self):
+        """``(n, 2)`` float stored poses (metres) of the live states of the pose factor, or None."""
         a = self._a
         return None if a.poses is None else a.poses[: a.num_states[a.pose_factor]]
 
@@ -187,8 +206,26 @@ class DenseStep(_Common):
 
 
 class LocalStep(_Common):
-    """One step of a single sparse factor from the sparse prior ``(prior_idx, prior_p)``
-    under each control in ``actions`` (K,)."""
+    """One planning step of a single sparse factor from a sparse prior, restricted to reachable states.
+
+    Every array is over ``U`` (attribute), the states the candidates can reach, so the cost is
+    independent of the size of the map.
+
+    Parameters
+    ----------
+    prep : Prepared
+        Derived quantities of the decision (local path).
+    prior_idx : array_like
+        ``(R,)`` int states with prior mass.
+    prior_p : array_like
+        ``(R,)`` float their probabilities (sum to 1).
+    actions : array_like
+        ``(K,)`` int control of each candidate.
+    t : int, optional
+        Index of the step within the imagined policy, default 0.
+    collision : numpy.ndarray or None, optional
+        ``(K,)`` float probability of a collision per candidate, or None.
+    """
 
     def __init__(self, prep: Prepared, prior_idx, prior_p, actions, t: int = 0, collision=None):
         self.prep = prep
@@ -341,7 +378,13 @@ class LocalStep(_Common):
         )
 
     def most_likely(self) -> np.ndarray:
-        """Most likely next state per candidate (summing repeated states of a point prior)."""
+        """Most likely next state per candidate (summing repeated states of a point prior).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(K,)`` int state indices.
+        """
         if self._point:
             K = self.num_candidates
             succ = self.U.reshape(K, -1)
