@@ -66,27 +66,33 @@ class _Common:
 
     @property
     def num_candidates(self) -> int:
+        """Number of candidates ``K`` evaluated in this step."""
         return self.actions.shape[0]
 
     @property
     def C(self) -> list:
+        """Per modality, the ``(num_obs[m],)`` float log-preferences over live outcomes."""
         a = self.prep.arrays
         return [a.C[m][: a.num_obs[m]] for m in range(len(a.A))]
 
     @property
     def pose_factor(self) -> int:
+        """Index of the factor carrying poses."""
         return self.prep.arrays.pose_factor
 
     @property
     def pose_sigma(self) -> float:
+        """Width (metres) of the position preference."""
         return self.prep.arrays.pose_sigma
 
     @property
     def target_pose(self):
+        """``(2,)`` float target position (metres) of the position preference, or None."""
         return self.prep.arrays.target_pose
 
     @property
     def collision_pref(self) -> float:
+        """Log-preference of a collision (no collision: 0)."""
         return self.prep.arrays.collision_pref
 
 
@@ -130,24 +136,29 @@ class DenseStep(_Common):
 
     @cached_property
     def qo(self) -> list:
+        """Per modality, ``(K, num_obs[m])`` float predicted outcome distribution of each candidate."""
         a = self._a
         return [expect(a.live_A(m), [self.qs[f] for f in a.A_deps[m]], True) for m in range(len(a.A))]
 
     @cached_property
     def outcome_entropy(self) -> list:
+        """Per modality, ``(K,)`` float entropy (nats) of the predicted outcome distribution."""
         return [entropy(qo, axis=1) for qo in self.qo]
 
     @cached_property
     def outcome_utility(self) -> list:
+        """Per modality, ``(K,)`` float expected log-preference ``Q(o_m) . C_m``."""
         return [qo @ c for qo, c in zip(self.qo, self.C, strict=True)]
 
     @cached_property
     def ambiguity(self) -> list:
+        """Per modality, ``(K,)`` float expected column entropy ``E_Q(s)[H[P(o_m|s)]]`` (nats)."""
         a = self._a
         return [expect(self.prep.HA[m], [self.qs[f] for f in a.A_deps[m]]) for m in range(len(a.A))]
 
     @cached_property
     def a_novelty(self) -> list:
+        """Per modality, ``(K,)`` float information gain about ``A``'s parameters, or None without counts."""
         a = self._a
         out = []
         for m, w in enumerate(self.prep.wA):
@@ -160,6 +171,7 @@ class DenseStep(_Common):
 
     @cached_property
     def b_novelty(self) -> list:
+        """Per factor, ``(K,)`` float information gain about ``B``'s parameters, or None without counts."""
         out = []
         for f, w in enumerate(self.prep.wB):
             if w is None:
@@ -189,6 +201,7 @@ class DenseStep(_Common):
 
     @cached_property
     def view(self):
+        """``(K,)`` float expected unseen fraction of the predicted state's view, or None without a view."""
         v = self._a.view
         if v is None:
             return None
@@ -197,6 +210,11 @@ class DenseStep(_Common):
 
     @cached_property
     def closer(self):
+        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
+
+        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
+        AIMAPP paper).
+        """
         dist = self.prep.dist
         if dist is None:
             return None
@@ -292,11 +310,13 @@ class LocalStep(_Common):
 
     @cached_property
     def outcome_entropy(self) -> list:
+        """Per modality, ``(K,)`` float entropy (nats) of the predicted outcome distribution."""
         return [-(self._a.num_obs[m] - outcomes.size) * xlogx(bg) - xlogx(values).sum(axis=1)
                 for m, (bg, outcomes, values) in enumerate(self._outcomes)]
 
     @cached_property
     def outcome_utility(self) -> list:
+        """Per modality, ``(K,)`` float expected log-preference ``Q(o_m) . C_m``."""
         a = self._a
         out = []
         for m, (bg, outcomes, values) in enumerate(self._outcomes):
@@ -307,12 +327,16 @@ class LocalStep(_Common):
 
     @cached_property
     def ambiguity(self) -> list:
+        """Per modality, ``(K,)`` float expected column entropy ``E_Q(s)[H[P(o_m|s)]]`` (nats)."""
         return [self.qs[0] @ st[0] for st in self._stats]
 
     @cached_property
     def a_novelty(self) -> list:
-        """``sum_o Q(o) E_Q(s)[W(o, s)]`` from the compressed outcomes: every unlisted outcome
-        shares the background weight of each column; listed slots add their difference."""
+        """Per modality, ``(K,)`` float information gain about ``A``'s parameters, or None without counts.
+
+        ``sum_o Q(o) E_Q(s)[W(o, s)]`` from the compressed outcomes: every unlisted outcome shares the
+        background weight of each column; listed slots add their difference.
+        """
         qs = self.qs[0]
         out = []
         for m, A in enumerate(self._a.A):
@@ -330,6 +354,7 @@ class LocalStep(_Common):
 
     @cached_property
     def b_novelty(self) -> list:
+        """One-element list: ``(K,)`` float information gain about ``B``'s parameters, or None without counts."""
         B = self._a.B[0]
         if getattr(B, "counts", None) is None:
             return [None]
@@ -353,21 +378,29 @@ class LocalStep(_Common):
 
     @cached_property
     def C_states(self) -> list:
+        """One-element list: ``(U,)`` float log-preferences over the reachable states ``U`` (or None)."""
         a = self._a
         return [None if a.C_states is None else a.C_states[0][self.U]]
 
     @cached_property
     def poses(self):
+        """``(U, 2)`` float stored poses (metres) of the reachable states ``U``, or None."""
         a = self._a
         return None if a.poses is None else a.poses[self.U]
 
     @cached_property
     def view(self):
+        """``(K,)`` float expected unseen fraction of the predicted state's view, or None without a view."""
         v = self._a.view
         return None if v is None else self.qs[0] @ v[self.U]
 
     @cached_property
     def closer(self):
+        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
+
+        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
+        AIMAPP paper).
+        """
         dist = self.prep.dist
         if dist is None:
             return None
