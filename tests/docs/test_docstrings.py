@@ -5,7 +5,8 @@ callables their ``__init__`` re-exports), plus the public functions and classes 
 ``cogmap.loop`` and ``cogmap.harness``; for each class, its public methods. A callable with
 parameters (other than ``self``/``cls``) needs a ``Parameters`` section (``Attributes`` also counts
 for a class, e.g. a dataclass); a function whose own body has ``return <value>`` needs ``Returns``
-(``Yields`` for a generator). Properties need a docstring only.
+(``Yields`` for a generator). Properties (also cached ones) need a docstring only. Methods inherited
+from cogmap base classes are checked too.
 
 Run ``python tests/docs/test_docstrings.py`` to print every problem.
 """
@@ -138,11 +139,22 @@ def _check_class(qualname: str, cls) -> list[str]:
         problems.append(f"{qualname}: no docstring")
     elif _constructor_has_parameters(cls) and not _section(inspect.cleandoc(doc), "Parameters", "Attributes"):
         problems.append(f"{qualname}: no Parameters/Attributes section")
-    for name, attr in vars(cls).items():
-        if name.startswith("_"):
+    done: set[str] = set()
+    for klass in cls.__mro__:  # the class's own public methods, then those inherited from cogmap classes
+        if klass is not cls and not klass.__module__.startswith("cogmap"):
             continue
+        problems += _check_members(qualname if klass is cls else f"{qualname}({klass.__qualname__})", klass, done)
+    return problems
+
+
+def _check_members(qualname: str, klass, done: set[str]) -> list[str]:
+    problems = []
+    for name, attr in vars(klass).items():
+        if name.startswith("_") or name in done:
+            continue
+        done.add(name)
         where = f"{qualname}.{name}"
-        if isinstance(attr, property):
+        if isinstance(attr, property) or type(attr).__name__ == "cached_property":
             if not (attr.__doc__ and attr.__doc__.strip()):
                 problems.append(f"{where}: no docstring")
         elif isinstance(attr, staticmethod):
