@@ -171,9 +171,10 @@ class InductiveSpec:
     Attributes
     ----------
     threshold : float
-        Reachability threshold in [0, 1], default 0.5.
+        Transition probability in [0, 1] above which a move counts as believed possible, default 0.5.
     depth : int
-        Number of steps the reachability is propagated, at least 1; default 10.
+        Horizon in believed-possible moves: goals farther away are ignored; at least 1, default 10
+        (also the default MCTS depth of :func:`cogmap.planning.decide`).
     weight : float
         Weight of the term in the expected free energy, default 1.
     """
