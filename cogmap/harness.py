@@ -27,7 +27,25 @@ from cogmap.metrics import CoverageTracker
 
 @dataclass
 class Episode:
-    """What a run produced (kept in memory; :func:`cogmap.explore.write_run` stores it)."""
+    """What a run produced (kept in memory; :func:`cogmap.explore.write_run` stores it).
+
+    Every list has one entry per recorded step, and ``coverage`` and ``distance`` one more at the end
+    (the state after the last motion).
+
+    Attributes
+    ----------
+    rows : list of dict
+        Trajectory rows: step, true and odometry pose (metres, radians), the policy's own fields,
+        ``moved``, ``coverage``, ``distance`` and ``decision_ms``.
+    coverage : list of float
+        LiDAR coverage in [0, 1] of the reachable free area.
+    distance : list of float
+        Cumulative true distance driven, metres.
+    decision_ms : list of float
+        Wall-clock time of each decision, milliseconds.
+    num_states : list of int
+        Size of the policy's map at each step (0 when it reports none).
+    """
 
     rows: list[dict] = field(default_factory=list)
     coverage: list[float] = field(default_factory=list)
@@ -40,12 +58,22 @@ class Episode:
 class Command:
     """A policy's decision at one step, as the harness executes and records it.
 
-    ``waypoint`` is where to drive in ``frame`` ("odom" or "world"), None to stay in place;
-    ``done`` means the policy has finished (the step is recorded, nothing is executed and the
-    episode ends). ``row`` holds the policy's own trajectory fields (believed pose, state,
-    action, mode, ...; see :data:`cogmap.explore.TRAJ_FIELDS`), ``status`` extra fields for the
-    progress bar and ``decision`` the policy's own decision object, handed to ``on_step`` and
-    ``stop``."""
+    Attributes
+    ----------
+    waypoint : numpy.ndarray or None
+        ``(2,)`` float where to drive, metres, in ``frame``; None to stay in place.
+    frame : str
+        ``"odom"`` (default) or ``"world"``.
+    row : dict
+        The policy's own trajectory fields (believed pose, state, action, mode, ...; see
+        :data:`cogmap.explore.TRAJ_FIELDS`).
+    done : bool
+        The policy has finished: the step is recorded, nothing is executed and the episode ends.
+    status : dict
+        Extra fields for the progress bar.
+    decision : object
+        The policy's own decision object, handed to ``on_step`` and ``stop``.
+    """
 
     waypoint: np.ndarray | None
     frame: str = "odom"
@@ -57,15 +85,44 @@ class Command:
 
 @runtime_checkable
 class Policy(Protocol):
-    """What the harness needs of a policy."""
+    """What the harness needs of a policy (a runtime-checkable protocol).
+
+    Attributes
+    ----------
+    label : str
+        Progress-bar description.
+    """
 
     label: str  # progress-bar description
 
     def sense(self, sim, moved: bool | None) -> Any:
-        """What the policy senses this step (read from ``sim``, only the streams it may use)."""
+        """What the policy senses this step (read from ``sim``, only the streams it may use).
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+        moved : bool or None
+            Whether the last motion command succeeded; None before the first.
+
+        Returns
+        -------
+        object
+            Whatever :meth:`step` expects.
+        """
 
     def step(self, sensed) -> Command:
-        """Decide from ``sensed``."""
+        """Decide from what was sensed.
+
+        Parameters
+        ----------
+        sensed : object
+            The value :meth:`sense` returned.
+
+        Returns
+        -------
+        Command
+        """
 
 
 # The coverage of a simulator run is kept per simulator (runs that follow one another in one
@@ -74,8 +131,20 @@ _TRACKERS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def coverage_tracker(sim) -> CoverageTracker:
-    """The LiDAR coverage of this simulator run, over the free area reachable from where the run
-    began (created at the first call for ``sim``)."""
+    """The LiDAR coverage of this simulator run, created at the first call for ``sim``.
+
+    Coverage is measured over the free area reachable from where the run began; later runs in the
+    same simulator keep adding to it.
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+
+    Returns
+    -------
+    CoverageTracker
+    """
     tracker = _TRACKERS.get(sim)
     if tracker is None:
         free = sim.grid.reachable(sim.true_pose()[:2])
@@ -84,13 +153,34 @@ def coverage_tracker(sim) -> CoverageTracker:
 
 
 def sweep(sim, tracker: CoverageTracker) -> None:
-    """Add what the LiDAR sweeps now to the coverage (nothing while the LiDAR is silent)."""
+    """Add what the LiDAR sweeps now to the coverage (nothing while the LiDAR is silent).
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+    tracker : CoverageTracker
+        The run's coverage (:func:`coverage_tracker`).
+    """
     if not sim.faults.dropped("lidar", sim.step_count):
         tracker.update(sim.lidar_hits()[0])
 
 
 def execute(sim, command: Command) -> bool:
-    """Drive (or stay) as commanded; returns whether the motion succeeded."""
+    """Drive (or stay) as commanded.
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+    command : Command
+        The decision; ``waypoint`` None means stay.
+
+    Returns
+    -------
+    bool
+        Whether the motion succeeded (False when stopped before a collision).
+    """
     if command.waypoint is None:
         return bool(sim.stay().success)
     return bool(sim.move_to(command.waypoint, frame=command.frame).success)
@@ -100,9 +190,35 @@ def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, epis
                 on_step=None, stop=None, stop_coverage: float | None = None, desc: str | None = None) -> Episode:
     """Drive ``policy`` in ``sim`` for at most ``steps`` decisions, tracking LiDAR coverage.
 
-    Ends early when the policy reports ``done``, when ``stop(decision)`` is true after a step
-    was executed, or when the coverage reaches ``stop_coverage`` before a decision. Passing the
-    ``episode`` of an earlier run continues it (rows, distance)."""
+    Ends early when the policy reports ``done``, when ``stop(decision)`` is true after a step was
+    executed, or when the coverage reaches ``stop_coverage`` before a decision.
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+    policy : Policy
+        The exploration policy.
+    steps : int
+        Largest number of decisions.
+    progress : bool, optional
+        Show a tqdm progress bar, default False.
+    episode : Episode, optional
+        The episode of an earlier run to continue (rows, distance).
+    on_step : callable, optional
+        Called with ``command.decision`` before each executed step.
+    stop : callable, optional
+        ``stop(decision) -> bool`` checked after each executed step.
+    stop_coverage : float, optional
+        Coverage in [0, 1] at which to stop.
+    desc : str, optional
+        Progress-bar description; default ``policy.label``.
+
+    Returns
+    -------
+    Episode
+        The (new or continued) episode record.
+    """
     from tqdm import tqdm
 
     ep = episode if episode is not None else Episode()

@@ -36,6 +36,31 @@ PLANNERS = ("enumerate", "mcts")
 
 
 class LoopConfig(NamedTuple):
+    """Settings of an agent built by :func:`init` (see its parameters).
+
+    Attributes
+    ----------
+    scheme : str
+        Registered inference scheme, default ``"fpi"``.
+    planner : str
+        ``"enumerate"`` (default) or ``"mcts"``.
+    policy_len : int
+        Steps per enumerated policy, default 1.
+    gamma : float
+        Policy precision, default 16.
+    objective : Objective or None
+        Per-step EFE (``init`` fills in ``efe.pymdp_like()`` when none is given).
+    mcts : MCTSConfig or None
+        MCTS settings; default ``MCTSConfig(gamma=gamma)``.
+    learn_A, learn_B : bool
+        Whether to learn the likelihood / the transitions, default False.
+    lr_A, lr_B : float
+        Their learning rates, default 1.
+    sample : bool
+        Sample the action from the policy posterior (False: its mode); default True.
+    scheme_options : dict or None
+        Keyword options of the inference scheme.
+    """
     scheme: str = "fpi"
     planner: str = "enumerate"
     policy_len: int = 1
@@ -51,6 +76,25 @@ class LoopConfig(NamedTuple):
 
 
 class LoopState(NamedTuple):
+    """The agent's immutable state between steps.
+
+    Attributes
+    ----------
+    model : Model
+        The compiled model (learnt in place when learning is on).
+    config : LoopConfig
+        The agent's settings.
+    prior : list of numpy.ndarray
+        ``(num_states[f],)`` float belief over each factor before this step's observation.
+    qs : list of numpy.ndarray or None
+        Posterior of the last step (None before the first).
+    action : tuple of int or None
+        Control per factor chosen at the last step.
+    rng : numpy.random.Generator
+        Random generator (action sampling, MCTS).
+    t : int
+        Number of steps taken.
+    """
     model: Model
     config: LoopConfig
     prior: list  # belief over each factor before this step's observation
@@ -61,6 +105,24 @@ class LoopState(NamedTuple):
 
 
 class StepInfo(NamedTuple):
+    """What happened in one :func:`step`.
+
+    Attributes
+    ----------
+    qs : list of numpy.ndarray
+        ``(num_states[f],)`` float posterior per factor.
+    action : tuple of int
+        Control per factor to apply now.
+    q_pi : numpy.ndarray or None
+        ``(P,)`` float policy posterior (enumeration); None with MCTS.
+    G : numpy.ndarray
+        Expected free energy per policy ``(P,)`` (enumeration) or backed-up value per root action
+        (MCTS).
+    policies : numpy.ndarray or None
+        ``(P, T, F)`` int policies of ``q_pi`` and ``G`` (enumeration).
+    free_energy : float
+        Variational free energy (nats) of this step's inference.
+    """
     qs: list  # posterior per factor
     action: tuple  # control per factor to apply now
     q_pi: np.ndarray | None  # policy posterior (enumeration), None with MCTS
@@ -86,11 +148,54 @@ def init(
     seed: int = 0,
     **scheme_options,
 ) -> LoopState:
-    """A fresh agent on ``model``: the prior is ``D``. ``objective`` is an
-    :class:`~cogmap.planning.efe.Objective` or a name of ``planning.decide.MODES``: "pymdp" (utility
-    + state information gain, pymdp's default ``neg_efe``; the default), "explore", "goal", "full",
-    "sensed"; ``scheme_options``
-    go to the inference scheme (e.g. ``num_iter=16``)."""
+    """A fresh agent on ``model``; the prior is ``D``.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model.
+    scheme : str, optional
+        Registered inference scheme, default ``"fpi"``.
+    planner : str, optional
+        ``"enumerate"`` (every policy of ``policy_len`` steps, default) or ``"mcts"``.
+    policy_len : int, optional
+        Policy length for enumeration, an integer >= 1; default 1.
+    gamma : float, optional
+        Policy precision, positive; default 16 (pymdp's ``Agent`` defaults to 1).
+    objective : Objective or str, optional
+        An :class:`~cogmap.planning.efe.Objective` or a name of ``planning.decide.MODES``
+        (``"pymdp"``: utility + state information gain, the default; ``"explore"``, ``"goal"``,
+        ``"full"``, ``"sensed"``).
+    mcts : MCTSConfig, optional
+        MCTS settings.
+    learn_A : bool, optional
+        Learn ``A`` after each inference (Eq. 8 of the AIMAPP paper); needs ``pA`` for every modality.
+    learn_B : bool, optional
+        Learn ``B`` for the control taken; needs dense transitions with ``pB`` for every factor.
+    lr_A, lr_B : float, optional
+        Learning rates, default 1.
+    sample : bool, optional
+        Sample actions from the policy posterior (default) instead of taking its mode.
+    seed : int, optional
+        Seed of the agent's generator, default 0.
+    **scheme_options
+        Passed to the inference scheme (e.g. ``num_iter=16``).
+
+    Returns
+    -------
+    LoopState
+
+    Raises
+    ------
+    TypeError
+        If ``model`` is not a compiled :class:`Model`.
+    KeyError
+        For an unknown inference scheme.
+    ValueError
+        For an unknown planner or objective name, or invalid ``policy_len`` / ``gamma``.
+    SpecError
+        If learning is asked for without the counts it needs.
+    """
     if not isinstance(model, Model):
         raise TypeError(f"init needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")
     inference.get(scheme)  # unknown names fail here, listing the known ones
@@ -128,7 +233,27 @@ def _observation(model: Model, observation) -> list:
 
 
 def step(state: LoopState, observation) -> tuple[LoopState, StepInfo]:
-    """Infer, learn, plan and act for one observation; returns the next state and what happened."""
+    """Infer, learn, plan and act for one observation.
+
+    Parameters
+    ----------
+    state : LoopState
+        The agent's state.
+    observation : sequence or dict or int
+        One entry per modality (an outcome index, a distribution over outcomes or None), a dict by
+        modality name, or a bare index for a single modality.
+
+    Returns
+    -------
+    state : LoopState
+        The next state (its prior is the posterior pushed through ``B`` under the chosen control).
+    info : StepInfo
+
+    Raises
+    ------
+    ValueError
+        If the observation does not have one entry per modality.
+    """
     model, cfg = state.model, state.config
     obs = _observation(model, observation)
     qs, info = inference.get(cfg.scheme)(model, state.prior, [obs], **(cfg.scheme_options or {}))

@@ -11,7 +11,25 @@ RGB = tuple[float, float, float]
 
 @dataclass(frozen=True)
 class Box:
-    """Upright box: centre (x, y), full footprint sizes (sx, sy), yaw in rad."""
+    """Upright box obstacle.
+
+    Attributes
+    ----------
+    name : str
+        Unique name within a layout.
+    x, y : float
+        Centre, metres, world frame.
+    sx, sy : float
+        Full footprint sizes along the box's own axes, metres.
+    height : float
+        Height in metres, default 1.
+    yaw : float
+        Rotation about the vertical axis, radians, default 0.
+    color : tuple of float
+        RGB in [0, 1].
+    movable : bool
+        Whether scenarios may move it.
+    """
 
     name: str
     x: float
@@ -26,7 +44,23 @@ class Box:
 
 @dataclass(frozen=True)
 class Cylinder:
-    """Upright cylinder: centre (x, y), radius and height."""
+    """Upright cylinder obstacle.
+
+    Attributes
+    ----------
+    name : str
+        Unique name within a layout.
+    x, y : float
+        Centre, metres, world frame.
+    radius : float
+        Radius in metres.
+    height : float
+        Height in metres, default 1.
+    color : tuple of float
+        RGB in [0, 1].
+    movable : bool
+        Whether scenarios may move it.
+    """
 
     name: str
     x: float

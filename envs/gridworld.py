@@ -36,7 +36,21 @@ def rooms_map(n_x: int = 2, n_y: int = 2, room: int = 4) -> np.ndarray:
 
 
 class GridWorld:
-    """Rich API mirroring `NavSim` on a discrete grid (no physics client)."""
+    """Rich API mirroring :class:`NavSim` on a discrete grid (no physics client).
+
+    Poses are ``(col, row, heading)`` ints, heading 0..3 = east, north, west, south; actions 0..3
+    move one cell toward that heading, action 4 stays. Free cells are numbered in row-major order
+    of the wall map; ``cells`` holds their ``(x, y)`` and ``colors`` their colour.
+
+    Parameters
+    ----------
+    walls : numpy.ndarray, optional
+        ``(rows, cols)`` bool wall map (rows = y); default :func:`rooms_map` (2 x 2 rooms of 4 cells).
+    n_colors : int, optional
+        Number of colours drawn uniformly per free cell, default 6.
+    seed : int, optional
+        Seed of the colours and of the first start draw, default 0.
+    """
 
     n_actions = 5
 
@@ -55,6 +69,7 @@ class GridWorld:
 
     @property
     def n_cells(self) -> int:
+        """Number of free cells (states)."""
         return len(self.cells)
 
     def _step_cell(self, cell: int, action: int) -> int:
@@ -66,10 +81,30 @@ class GridWorld:
         return cell
 
     def next_cell(self, cell: int, action: int) -> int:
+        """Cell reached from ``cell`` under ``action`` (the same cell when a wall blocks it or for stay).
+
+        Parameters
+        ----------
+        cell : int
+            Free-cell index.
+        action : int
+            Action 0..4.
+
+        Returns
+        -------
+        int
+            Free-cell index.
+        """
         return int(self._next[cell, action])
 
     def B(self) -> np.ndarray:
-        """Transition tensor B[next, current, action] (one-hot columns)."""
+        """Exact transition tensor ``B[next, current, action]`` (one-hot columns).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n_cells, n_cells, 5)`` float.
+        """
         B = np.zeros((self.n_cells, self.n_cells, self.n_actions))
         cur = np.arange(self.n_cells)
         for a in range(self.n_actions):
@@ -77,16 +112,47 @@ class GridWorld:
         return B
 
     def A(self) -> np.ndarray:
-        """Observation matrix A[colour, cell] (one-hot columns)."""
+        """Exact observation matrix ``A[colour, cell]`` (one-hot columns).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n_colors, n_cells)`` float.
+        """
         A = np.zeros((self.n_colors, self.n_cells))
         A[self.colors, np.arange(self.n_cells)] = 1.0
         return A
 
     def cell_of(self, xy) -> int:
+        """Free-cell index at grid position ``xy`` (-1 on a wall).
+
+        Parameters
+        ----------
+        xy : sequence
+            ``(x, y)`` = (column, row).
+
+        Returns
+        -------
+        int
+        """
         return int(self.index[int(xy[1]), int(xy[0])])
 
     # ------------------------------------------------------------- episode API
     def reset(self, seed=None, start=None) -> np.ndarray:
+        """Start an episode: place the agent facing east, zero the odometry offset, clear faults.
+
+        Parameters
+        ----------
+        seed : int or numpy.random.Generator or None, optional
+            Seed (or generator) of the start draw.
+        start : int, optional
+            Start cell index; default drawn uniformly.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(3,)`` int true pose ``(col, row, heading)``.
+        """
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         cell = int(self.rng.integers(self.n_cells)) if start is None else int(start)
         self.cell, self.heading = cell, 0
@@ -96,14 +162,45 @@ class GridWorld:
         return self.true_pose()
 
     def true_pose(self) -> np.ndarray:
+        """True pose ``(col, row, heading)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(3,)`` int.
+        """
         return np.array([*self.cells[self.cell], self.heading], int)
 
     def odometry(self) -> np.ndarray | None:
+        """Odometry pose ``(col, row, heading)`` (exact increments), or None while the stream is dropped.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(3,)`` int.
+        """
         if self.faults.dropped("odometry", self.step_count):
             return None
         return self.odom.copy()
 
     def step_action(self, action: int) -> MoveResult:
+        """Apply an action for one step; a move into a wall fails and leaves the agent in place.
+
+        Parameters
+        ----------
+        action : int
+            0..3 move east/north/west/south (and face it), 4 stays.
+
+        Returns
+        -------
+        MoveResult
+            ``distance`` and ``requested`` in cells (1 or 0), poses as ``(col, row, heading)``.
+
+        Raises
+        ------
+        ValueError
+            If ``action`` is out of range.
+        """
         if not 0 <= int(action) < self.n_actions:
             raise ValueError(f"action must be in [0, {self.n_actions - 1}]")
         start = self.true_pose()
@@ -121,26 +218,75 @@ class GridWorld:
                           self.true_pose())
 
     def observe(self) -> int | None:
-        """Colour index of the current cell, or None while the camera is dropped."""
+        """Colour index of the current cell, or None while the camera is dropped.
+
+        Returns
+        -------
+        int or None
+        """
         if self.faults.dropped("camera", self.step_count):
             return None
         return int(self.colors[self.cell])
 
     def obstacle_signal(self) -> np.ndarray | None:
-        """1 where heading k is blocked by a wall; None while the LiDAR is dropped."""
+        """Per heading 0..3, 1 where a wall blocks the move; None while the LiDAR is dropped.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(4,)`` int8.
+        """
         if self.faults.dropped("lidar", self.step_count):
             return None
         return (self._next[self.cell, :4] == self.cell).astype(np.int8)
 
     def teleport(self, cell: int) -> None:
+        """Kidnap the agent to another cell (odometry does not notice).
+
+        Parameters
+        ----------
+        cell : int
+            Free-cell index.
+        """
         self.cell = int(cell)
 
     def inject_fault(self, stream: str, start_step: int, length: int) -> None:
+        """Drop a stream for steps ``[start_step, start_step + length)``.
+
+        Parameters
+        ----------
+        stream : str
+            ``"lidar"``, ``"camera"`` or ``"odometry"``.
+        start_step : int
+            First step without data.
+        length : int
+            Number of steps without data.
+        """
         self.faults.add(stream, start_step, length)
 
 
 class GridWorldEnv(gym.Env):
-    """Gymnasium view of `GridWorld`. Dropped colour = `n_colors`; see `valid`."""
+    """Gymnasium view of :class:`GridWorld`.
+
+    Observations are dicts: ``"color"`` (``n_colors`` when the camera is dropped), ``"odometry"``
+    ``(3,)`` int64, ``"obstacle"`` ``(4,)`` int8 and ``"valid"`` ``(3,)`` int8 flags for
+    (obstacle, colour, odometry) being present. Reward is always 0 and episodes never end.
+
+    Parameters
+    ----------
+    n_x, n_y : int, optional
+        Rooms along x and y, default 2 x 2.
+    room : int, optional
+        Room side in cells, default 4.
+    n_colors : int, optional
+        Number of colours, default 6.
+    world_seed : int, optional
+        Seed of the colours, default 0.
+    faults : sequence of tuple, optional
+        ``(stream, start_step, length)`` dropouts applied on every reset.
+    render_mode : str, optional
+        ``"rgb_array"`` or None.
+    """
 
     metadata = {"render_modes": ["rgb_array"], "render_fps": 4}
 
@@ -158,6 +304,22 @@ class GridWorldEnv(gym.Env):
         self.action_space = spaces.Discrete(GridWorld.n_actions)
 
     def reset(self, *, seed=None, options=None):
+        """Reset the episode (Gymnasium API).
+
+        Parameters
+        ----------
+        seed : int, optional
+            Seed of the environment's generator.
+        options : dict, optional
+            ``"start"``: start cell index; ``"faults"``: extra ``(stream, start_step, length)`` dropouts.
+
+        Returns
+        -------
+        observation : dict
+            As described in the class docstring.
+        info : dict
+            ``{"true_pose": (3,) int}``.
+        """
         super().reset(seed=seed)
         options = options or {}
         self.world.reset(self.np_random, options.get("start"))
@@ -166,6 +328,23 @@ class GridWorldEnv(gym.Env):
         return self._obs(), {"true_pose": self.world.true_pose()}
 
     def step(self, action):
+        """Take one action (Gymnasium API).
+
+        Parameters
+        ----------
+        action : int
+            0..4 (see :class:`GridWorld`).
+
+        Returns
+        -------
+        observation : dict
+        reward : float
+            Always 0.
+        terminated, truncated : bool
+            Always False.
+        info : dict
+            ``"true_pose"`` and ``"success"`` (False when a wall blocked the move).
+        """
         res = self.world.step_action(int(action))
         info = {"true_pose": self.world.true_pose(), "success": res.success}
         return self._obs(), 0.0, False, False, info
@@ -181,6 +360,13 @@ class GridWorldEnv(gym.Env):
         }
 
     def render(self):
+        """Image of the map with the agent in red (``render_mode="rgb_array"`` only).
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(8 * rows, 8 * cols, 3)`` uint8, north up; None in other render modes.
+        """
         if self.render_mode != "rgb_array":
             return None
         img = np.where(self.world.walls[..., None], 30, 230).astype(np.uint8).repeat(3, 2)

@@ -42,11 +42,27 @@ WALL_THICKNESS = 0.006
 
 @dataclass(frozen=True)
 class Maze:
-    """Cells, open passages and walls of one maze.
+    """Cells, open passages and walls of one maze, filling ``[0, size]^2`` (world units).
 
-    ``east[i, j]`` is True when a wall separates cell ``(i, j)`` from ``(i + 1, j)``
-    (``i`` counts along x, ``j`` along y); ``north[i, j]`` likewise toward ``(i, j + 1)``.
-    ``walls`` holds axis-aligned boxes ``(cx, cy, sx, sy)`` including the outer boundary.
+    Attributes
+    ----------
+    seed : int
+        Seed it was generated with.
+    complexity : str
+        ``"simple"``, ``"moderate"`` or ``"complex"`` (3, 6, 12 cells per side).
+    corridor : str
+        ``"small"``, ``"medium"`` or ``"large"`` (the cell side, Table II of the DVBF-LM paper).
+    n : int
+        Cells per side.
+    size : float
+        Side of the square the maze fills.
+    east : numpy.ndarray
+        ``(n - 1, n)`` bool, True when a wall separates cell ``(i, j)`` from ``(i + 1, j)`` (``i``
+        counts along x, ``j`` along y).
+    north : numpy.ndarray
+        ``(n, n - 1)`` bool, likewise toward ``(i, j + 1)``.
+    walls : numpy.ndarray
+        ``(K, 4)`` float axis-aligned boxes ``(cx, cy, sx, sy)``, including the outer boundary.
     """
 
     seed: int
@@ -60,6 +76,7 @@ class Maze:
 
     @property
     def cell(self) -> float:
+        """Side of one cell (``size / n``)."""
         return self.size / self.n
 
     @property
@@ -74,17 +91,52 @@ class Maze:
 
     @property
     def step_budget(self) -> int:
+        """Exploration step budget the paper uses for this maze (Table II of the DVBF-LM paper)."""
         return TABLE_II[(self.complexity, self.corridor)][2]
 
     def cell_centre(self, i: int, j: int) -> np.ndarray:
+        """Centre of cell ``(i, j)``.
+
+        Parameters
+        ----------
+        i, j : int
+            Cell indices along x and y.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float position.
+        """
         return (np.array([i, j], float) + 0.5) * self.cell
 
     def cell_of(self, xy) -> tuple[int, int]:
+        """Cell containing position ``xy`` (clipped to the maze).
+
+        Parameters
+        ----------
+        xy : array_like
+            Position; its first two entries are ``(x, y)``.
+
+        Returns
+        -------
+        tuple of int
+            ``(i, j)``.
+        """
         ij = np.clip(np.floor(np.asarray(xy, float)[:2] / self.cell).astype(int), 0, self.n - 1)
         return int(ij[0]), int(ij[1])
 
     def neighbours(self, i: int, j: int) -> list[tuple[int, int]]:
-        """Cells reachable from ``(i, j)`` without crossing a wall."""
+        """Cells reachable from ``(i, j)`` in one step without crossing a wall.
+
+        Parameters
+        ----------
+        i, j : int
+            Cell indices along x and y.
+
+        Returns
+        -------
+        list of tuple of int
+        """
         out = []
         if i + 1 < self.n and not self.east[i, j]:
             out.append((i + 1, j))
@@ -97,7 +149,13 @@ class Maze:
         return out
 
     def segments(self) -> np.ndarray:
-        """Wall centre lines as ``(K, 4)`` rows ``x0, y0, x1, y1``."""
+        """Wall centre lines.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(K, 4)`` float rows ``x0, y0, x1, y1``.
+        """
         cx, cy, sx, sy = self.walls.T
         horiz = sx >= sy
         half = np.where(horiz, sx, sy) / 2
@@ -105,7 +163,18 @@ class Maze:
                          np.where(horiz, cx + half, cx), np.where(horiz, cy, cy + half)], 1)
 
     def occupancy(self, resolution: int = 200) -> np.ndarray:
-        """Boolean ``(resolution, resolution)`` raster, ``[ix, iy]`` True where a wall lies."""
+        """Boolean raster of the walls (slightly dilated by half a pixel).
+
+        Parameters
+        ----------
+        resolution : int, optional
+            Pixels per side, default 200.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(resolution, resolution)`` bool, ``[ix, iy]`` True where a wall lies.
+        """
         c = (np.arange(resolution) + 0.5) * self.size / resolution
         X, Y = np.meshgrid(c, c, indexing="ij")
         occ = np.zeros_like(X, bool)
@@ -115,13 +184,37 @@ class Maze:
         return occ
 
     def tile_index(self, xy) -> np.ndarray:
-        """Evaluation-tile index ``(K, 2)`` of positions ``(K, >=2)``."""
+        """Evaluation-tile index of positions (Table II tiles per side).
+
+        Parameters
+        ----------
+        xy : array_like
+            ``(K, >=2)`` or ``(>=2,)`` positions.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(K, 2)`` int tile indices, clipped to the grid.
+        """
         xy = np.atleast_2d(np.asarray(xy, float))[:, :2]
         return np.clip(np.floor(xy / self.size * self.tiles).astype(int), 0, self.tiles - 1)
 
 
 def exploration_ratio(maze: Maze, positions) -> float:
-    """Fraction of the Table II evaluation tiles visited by ``positions`` (paper Appendix D)."""
+    """Fraction of the Table II evaluation tiles visited by ``positions`` (DVBF-LM paper, Appendix D).
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze.
+    positions : array_like
+        ``(K, >=2)`` visited positions.
+
+    Returns
+    -------
+    float
+        In [0, 1].
+    """
     idx = maze.tile_index(positions)
     return len({tuple(r) for r in idx}) / maze.tiles**2
 
@@ -180,7 +273,28 @@ def _wall_boxes(n: int, cell: float, east: np.ndarray, north: np.ndarray, t: flo
 
 def make_maze(seed: int, complexity: str = "moderate", corridor: str = "medium",
               open_fraction: float = 0.15) -> Maze:
-    """A seeded random maze; ``open_fraction`` of the remaining inner walls is removed."""
+    """A seeded random maze: a perfect maze (randomised depth-first search) with some inner walls removed.
+
+    Parameters
+    ----------
+    seed : int
+        Random seed.
+    complexity : str, optional
+        ``"simple"``, ``"moderate"`` (default) or ``"complex"``.
+    corridor : str, optional
+        ``"small"``, ``"medium"`` (default) or ``"large"``.
+    open_fraction : float, optional
+        Fraction in [0, 1] of the remaining inner walls removed (opens loops), default 0.15.
+
+    Returns
+    -------
+    Maze
+
+    Raises
+    ------
+    ValueError
+        For an unknown complexity or corridor, or ``open_fraction`` outside [0, 1].
+    """
     if complexity not in CELLS:
         raise ValueError(f"make_maze: complexity must be one of {sorted(CELLS)}, got {complexity!r}")
     if corridor not in CORRIDOR:

@@ -18,7 +18,23 @@ def wrap(a):
 
 @dataclass
 class MoveResult:
-    """Outcome of one motion command (poses are ground truth (x, y, yaw))."""
+    """Outcome of one motion command (poses are ground truth ``(x, y, yaw)``).
+
+    Attributes
+    ----------
+    success : bool
+        False when the move stopped early before a collision.
+    distance : float
+        Distance travelled, metres.
+    requested : float
+        Distance requested, metres.
+    start, end : numpy.ndarray
+        ``(3,)`` float true poses (metres, metres, radians) before and after the move.
+    blocked_by : str or None
+        Name of the shape that blocked the move, if any.
+    info : dict
+        Extra information (empty unless a caller fills it).
+    """
 
     success: bool
     distance: float
@@ -57,9 +73,16 @@ def straight_move(shapes: ShapeSet, radius: float, start_xy, target_xy,
 class OdometryNoise:
     """Odometry error model (all zero = perfect odometry).
 
-    slip: fractional over-read of travelled distance (0.05 reports 1.05 m per true metre).
-    heading_bias: yaw drift in rad per metre travelled.
-    trans_std: random distance error, m per sqrt(m). rot_std: random yaw error, rad per sqrt(m).
+    Attributes
+    ----------
+    slip : float
+        Fractional over-read of travelled distance (0.05 reports 1.05 m per true metre).
+    heading_bias : float
+        Yaw drift in radians per metre travelled.
+    trans_std : float
+        Random distance error, metres per sqrt(metre).
+    rot_std : float
+        Random yaw error, radians per sqrt(metre).
     """
 
     slip: float = 0.0

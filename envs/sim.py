@@ -31,7 +31,39 @@ from .sensors import FaultSchedule, lidar_angles, obstacle_signal
 
 @dataclass(frozen=True)
 class SimConfig:
-    """Robot, sensor and motion parameters (TurtleBot3-Waffle-like defaults)."""
+    """Robot, sensor and motion parameters (TurtleBot3-Waffle-like defaults).
+
+    Attributes
+    ----------
+    robot_radius : float
+        Radius (m) of the disc robot used for collisions.
+    robot_height : float
+        Height (m) of the robot body.
+    lidar_height : float
+        Height (m) of the LiDAR plane.
+    lidar_beams : int
+        Beams per scan, evenly spaced over 360 degrees (default 360).
+    lidar_range : float
+        Maximum range (m), default 12.
+    camera_height : float
+        Height (m) of the panoramic camera.
+    image_size : tuple of int
+        ``(height, width)`` pixels of one view.
+    n_views : int
+        Views per panorama, default 4.
+    n_directions : int
+        Discrete move directions (the action set adds one stay action), default 12.
+    step_length : float
+        Length (m) of one discrete move, default 0.5.
+    obstacle_margin : float
+        Extra distance (m) in the obstacle signal's threshold.
+    move_increment : float
+        Spacing (m) of the collision checks along a move.
+    resolution : float
+        Cell size (m) of the ground-truth occupancy grid.
+    noise : OdometryNoise
+        Odometry error model (default perfect odometry).
+    """
 
     robot_radius: float = ROBOT_RADIUS
     robot_height: float = 0.2
@@ -50,11 +82,26 @@ class SimConfig:
 
     @property
     def fov_deg(self) -> float:
+        """Horizontal field of view of one view, degrees (``360 / n_views``)."""
         return 360.0 / self.n_views
 
 
 class NavSim:
-    """A layout in pybullet with a kinematic disc robot, LiDAR, panoramic camera, odometry."""
+    """A layout in pybullet with a kinematic disc robot, LiDAR, panoramic camera and odometry.
+
+    Parameters
+    ----------
+    layout : Layout or str, optional
+        A layout, or the name of a built-in one (default ``"mini_warehouse"``).
+    config : SimConfig, optional
+        Robot and sensor parameters; default ``SimConfig()``.
+    seed : int, optional
+        Seed of the start draw and odometry noise.
+    layout_seed : int, optional
+        Seed passed to :func:`make_layout` for a named layout, default 0.
+    start : array_like or int, optional
+        Start pose ``(x, y, yaw)`` or an index into ``layout.starts``.
+    """
 
     def __init__(self, layout: Layout | str = "mini_warehouse", config: SimConfig | None = None,
                  seed: int | None = None, layout_seed: int = 0, start=None):
@@ -71,8 +118,18 @@ class NavSim:
     def reset(self, seed: int | np.random.Generator | None = None, start=None) -> np.ndarray:
         """Restore the layout, clear faults and scheduled moves, place the robot.
 
-        `start` is a pose (x, y, yaw) or an index into `layout.starts`; by default the
-        start is drawn from `layout.starts` with the seeded generator. Returns the true pose.
+        Parameters
+        ----------
+        seed : int or numpy.random.Generator or None, optional
+            Seed (or generator) for the start draw and odometry noise.
+        start : array_like or int, optional
+            A pose ``(x, y, yaw)`` (metres, radians, world frame) or an index into ``layout.starts``; by
+            default drawn from ``layout.starts`` with the seeded generator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(3,)`` float true pose.
         """
         self.rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         if getattr(self, "layout", None) is not self.base_layout:
@@ -96,6 +153,17 @@ class NavSim:
         return self.pose.copy()
 
     def layout_moved(self, name: str) -> bool:
+        """Whether the shape ``name`` is no longer where the base layout put it.
+
+        Parameters
+        ----------
+        name : str
+            Shape name.
+
+        Returns
+        -------
+        bool
+        """
         cur = getattr(self, "layout", None)
         return cur is not None and cur.shape(name) != self.base_layout.shape(name)
 
@@ -105,22 +173,53 @@ class NavSim:
         self.grid: OccupancyGrid = layout_grid(layout, self.config.resolution)
 
     def close(self) -> None:
+        """Disconnect the pybullet scene."""
         self.scene.close()
 
     # ----------------------------------------------------------------- motion
     def true_pose(self) -> np.ndarray:
+        """The true pose ``(x, y, yaw)`` in the world frame.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(3,)`` float, metres and radians (a copy).
+        """
         return self.pose.copy()
 
     def odometry(self) -> np.ndarray | None:
-        """Odometry pose (x, y, yaw), or None while the odometry stream is dropped."""
+        """The odometry pose ``(x, y, yaw)``, or None while the odometry stream is dropped.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(3,)`` float, metres and radians, odometry frame.
+        """
         if self.faults.dropped("odometry", self.step_count):
             return None
         return self.odom.pose.copy()
 
     def move_to(self, waypoint, frame: str = "odom") -> MoveResult:
-        """Turn toward `waypoint` and drive straight to it, stopping before any collision.
+        """Turn toward ``waypoint`` and drive straight to it, stopping before any collision.
 
         One call is one step (step counter, faults and scheduled obstacle moves advance).
+
+        Parameters
+        ----------
+        waypoint : array_like
+            ``(x, y)`` in metres (extra entries ignored).
+        frame : str, optional
+            ``"odom"`` (default: relative to where the robot believes it is) or ``"world"``.
+
+        Returns
+        -------
+        MoveResult
+            Ground-truth outcome of the move.
+
+        Raises
+        ------
+        ValueError
+            For another frame.
         """
         wp = np.asarray(waypoint, float)[:2]
         if frame == "odom":
@@ -132,14 +231,43 @@ class NavSim:
         return self._drive(target)
 
     def move_heading(self, heading: float, distance: float | None = None) -> MoveResult:
-        """Drive `distance` (default step_length) along an odometry-frame heading (rad)."""
+        """Drive ``distance`` along an odometry-frame heading (one step).
+
+        Parameters
+        ----------
+        heading : float
+            Heading in radians, odometry frame.
+        distance : float, optional
+            Metres; default ``config.step_length``.
+
+        Returns
+        -------
+        MoveResult
+            Ground-truth outcome of the move.
+        """
         d = self.config.step_length if distance is None else float(distance)
         true_heading = heading + (self.pose[2] - self.odom.pose[2])
         return self._drive(self.pose[:2] + d * np.array([np.cos(true_heading),
                                                          np.sin(true_heading)]))
 
     def step_action(self, action: int) -> MoveResult:
-        """Discrete action: 0..n_directions-1 = heading k * 360 / n, n_directions = stay."""
+        """Discrete action: ``0 .. n_directions - 1`` move along heading ``k * 360 / n``; ``n_directions`` stays.
+
+        Parameters
+        ----------
+        action : int
+            Action index in ``[0, n_directions]``.
+
+        Returns
+        -------
+        MoveResult
+            Ground-truth outcome of the move.
+
+        Raises
+        ------
+        ValueError
+            If ``action`` is out of range.
+        """
         n = self.config.n_directions
         if not 0 <= int(action) <= n:
             raise ValueError(f"action must be in [0, {n}]")
@@ -148,6 +276,13 @@ class NavSim:
         return self.move_heading(2 * np.pi * int(action) / n)
 
     def stay(self) -> MoveResult:
+        """Stay in place for one step (step counter, faults and scheduled moves advance).
+
+        Returns
+        -------
+        MoveResult
+            Ground-truth outcome of the move.
+        """
         start = self.pose.copy()
         self._advance()
         return MoveResult(True, 0.0, 0.0, start, self.pose.copy())
@@ -192,7 +327,13 @@ class NavSim:
         self.odom_path.append(self.odom.pose.copy())
 
     def teleport(self, pose) -> None:
-        """Kidnap the robot: the true pose changes, odometry does not notice."""
+        """Kidnap the robot: the true pose changes, odometry does not notice.
+
+        Parameters
+        ----------
+        pose : array_like
+            ``(3,)`` float new true pose ``(x, y, yaw)``, metres and radians, world frame.
+        """
         self.pose = np.array(pose, float)
         self.scene.set_robot(self.pose)
         self._cache = {}
@@ -200,7 +341,17 @@ class NavSim:
 
     # ----------------------------------------------------------------- scene changes
     def move_obstacle(self, name: str, xy, yaw: float | None = None) -> None:
-        """Move a named shape now, in pybullet and in the occupancy grid."""
+        """Move a named shape now, in pybullet and in the occupancy grid.
+
+        Parameters
+        ----------
+        name : str
+            Shape name.
+        xy : array_like
+            New centre ``(x, y)``, metres, world frame.
+        yaw : float, optional
+            New yaw in radians (boxes); default unchanged.
+        """
         self._set_layout(self.layout.with_moved(name, xy, yaw))
         s = self.layout.shape(name)
         self.scene.move_body(name, s.x, s.y, getattr(s, "yaw", 0.0))
@@ -208,16 +359,45 @@ class NavSim:
 
     def schedule_obstacle_move(self, name: str, xy, at_step: int,
                                yaw: float | None = None) -> None:
-        """Move `name` once the step counter reaches `at_step`."""
+        """Move ``name`` once the step counter reaches ``at_step``.
+
+        Parameters
+        ----------
+        name : str
+            Shape name (unknown names raise at once).
+        xy : array_like
+            New centre ``(x, y)``, metres.
+        at_step : int
+            Step at which the move happens.
+        yaw : float, optional
+            New yaw in radians.
+        """
         self.layout.shape(name)  # raises on unknown names
         self.scheduled.append((int(at_step), name, tuple(xy), yaw))
 
     def inject_fault(self, stream: str, start_step: int, length: int) -> None:
-        """Drop `stream` ('lidar', 'camera' or 'odometry') for steps [start, start + length)."""
+        """Drop a sensor stream for steps ``[start_step, start_step + length)``.
+
+        Parameters
+        ----------
+        stream : str
+            ``"lidar"``, ``"camera"`` or ``"odometry"``.
+        start_step : int
+            First step without data.
+        length : int
+            Number of steps without data.
+        """
         self.faults.add(stream, start_step, length)
 
     # ----------------------------------------------------------------- sensors
     def lidar_angles(self) -> np.ndarray:
+        """Beam angles in the robot frame (beam 0 forward, counter-clockwise).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(lidar_beams,)`` float radians.
+        """
         return lidar_angles(self.config.lidar_beams)
 
     def _scan(self):
@@ -229,21 +409,43 @@ class NavSim:
         return self._cache["scan"]
 
     def lidar(self) -> np.ndarray | None:
-        """Ranges (m) from the robot centre per beam (robot frame), or None when dropped."""
+        """Ranges from the robot centre per beam (robot frame), or None when the LiDAR is dropped.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(lidar_beams,)`` float metres (``lidar_range`` where nothing is hit).
+        """
         if self.faults.dropped("lidar", self.step_count):
             return None
         return self._scan()[0].copy()
 
     def lidar_hits(self) -> tuple[np.ndarray, list]:
-        """World end points of all beams and the hit shape names (None = max range)."""
+        """World end points of all beams and the names of the shapes they hit (ignores faults).
+
+        Returns
+        -------
+        points : numpy.ndarray
+            ``(lidar_beams, 2)`` float, metres, world frame.
+        names : list of str or None
+            Shape hit by each beam (None at maximum range).
+        """
         ranges, ids = self._scan()
         a = self.pose[2] + self.lidar_angles()
         pts = self.pose[:2] + ranges[:, None] * np.stack([np.cos(a), np.sin(a)], 1)
         return pts, [self.scene.names.get(int(i)) if i >= 0 else None for i in ids]
 
     def obstacle_signal(self) -> np.ndarray | None:
-        """Per odometry-frame direction k: 1 if the sector minimum range is below
-        robot radius + step length + margin; None when the LiDAR is dropped."""
+        """Binary obstacle flag per odometry-frame direction ``k * 360 / n_directions``.
+
+        A direction is blocked when the minimum range in its sector is below
+        ``robot_radius + step_length + obstacle_margin``.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(n_directions,)`` int8, 1 = blocked; None when the LiDAR is dropped.
+        """
         ranges = self.lidar()
         if ranges is None:
             return None
@@ -253,8 +455,15 @@ class NavSim:
                                c.robot_radius + c.step_length + c.obstacle_margin)
 
     def panorama(self) -> np.ndarray | None:
-        """(h, w * n_views, 3) uint8, views left to right turning clockwise from odometry
-        heading +half a view; None when the camera is dropped."""
+        """Panoramic camera image; None when the camera is dropped.
+
+        Views are left to right turning clockwise from the odometry heading plus half a view.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(h, w * n_views, 3)`` uint8.
+        """
         if self.faults.dropped("camera", self.step_count):
             return None
         if "pano" not in self._cache:

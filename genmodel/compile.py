@@ -158,10 +158,32 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
 
 
 def compile(spec: ModelSpec, prior_count: float = 1.0, max_entries: int = MAX_ENTRIES) -> Model:  # noqa: A001
-    """Validate ``spec`` and return a :class:`Model`; raises :class:`SpecError` naming the
-    factor or modality and the problem.
+    """Validate ``spec`` once and return a :class:`Model` of arrays at capacity.
 
-    ``max_entries`` bounds the entries of any one reserved array (checked before allocating)."""
+    Checks shapes, normalisation, non-negativity, finiteness and names; dense likelihoods and
+    transitions are padded to the reserved capacity (columns of not-yet-live states are filled so
+    that every column stays normalised).
+
+    Parameters
+    ----------
+    spec : ModelSpec
+        The model specification.
+    prior_count : float, optional
+        Positive Dirichlet count given to new states and outcomes during growth, default 1.
+    max_entries : int, optional
+        Bound on the entries of any one reserved array, checked before allocating.
+
+    Returns
+    -------
+    Model
+        The compiled model.
+
+    Raises
+    ------
+    SpecError
+        Naming the factor or modality and the problem, for an invalid spec, a non-positive
+        ``prior_count``, arrays above ``max_entries`` or a failed allocation.
+    """
     if not isinstance(spec, ModelSpec):
         raise SpecError(f"compile() expects a ModelSpec, got {type(spec).__name__}")
     if isinstance(prior_count, bool) or not isinstance(prior_count, int | float | np.integer | np.floating) \

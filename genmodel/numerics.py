@@ -40,7 +40,20 @@ def softmax(x: np.ndarray) -> np.ndarray:
 
 
 def normalise(x: np.ndarray, axis: int = 0) -> np.ndarray:
-    """Normalise along ``axis``; all-zero columns become uniform."""
+    """Normalise along ``axis``; all-zero columns become uniform.
+
+    Parameters
+    ----------
+    x : array_like
+        Non-negative values.
+    axis : int, optional
+        Axis that sums to 1 afterwards, default 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        Float array of the shape of ``x``.
+    """
     x = np.asarray(x, dtype=float)
     s = x.sum(axis=axis, keepdims=True)
     n = x.shape[axis]

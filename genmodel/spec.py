@@ -30,9 +30,22 @@ class SpecError(ValueError):
 class Factor:
     """A hidden-state factor.
 
-    ``capacity`` reserves room for growth (defaults to the next power of two above ``size``
-    when ``growable``); ``stay`` names the control index that is structurally the identity
-    (never learned), or ``None``.
+    Attributes
+    ----------
+    name : str
+        Unique name, used as the key of ``A``/``B``/``D`` tables in :class:`ModelSpec`.
+    size : int
+        Initial number of states.
+    num_controls : int
+        Number of controls (actions) acting on the factor, default 1.
+    growable : bool
+        Whether states can be added after compilation.
+    capacity : int or None
+        Reserved room for growth; defaults to the next power of two above ``size`` when ``growable``.
+    stay : int or None
+        The control index that is structurally the identity (never learned), or None.
+    control_names : tuple of str or None
+        Optional names of the controls.
     """
 
     name: str
@@ -46,7 +59,21 @@ class Factor:
 
 @dataclass(frozen=True)
 class Modality:
-    """An observation modality depending on the named factors."""
+    """An observation modality depending on the named factors.
+
+    Attributes
+    ----------
+    name : str
+        Unique name, the key of ``A``/``C``/``pA`` tables in :class:`ModelSpec`.
+    size : int
+        Initial number of outcomes.
+    depends_on : tuple of str
+        Names of the factors the outcome depends on (the state axes of ``A``, in order).
+    growable : bool
+        Whether outcomes can be added after compilation.
+    capacity : int or None
+        Reserved room for growth (as for :class:`Factor`).
+    """
 
     name: str
     size: int
@@ -57,10 +84,20 @@ class Modality:
 
 @dataclass(frozen=True)
 class SparseB:
-    """Transitions stored as padded successor lists: ``succ[s, u, k]`` with probability
-    ``prob[s, u, k]`` (each ``prob[s, u, :]`` sums to 1; empty slots have probability 0).
+    """Transitions stored as padded successor lists.
 
-    Cost of a prediction grows with the number of edges, not with states squared.
+    ``succ[s, u, k]`` is a successor of ``s`` under control ``u`` with probability ``prob[s, u, k]``
+    (each ``prob[s, u, :]`` sums to 1; empty slots have probability 0). The cost of a prediction grows
+    with the number of edges, not with states squared.
+
+    Attributes
+    ----------
+    succ : array_like
+        ``(num_states, num_controls, slots)`` int successor states.
+    prob : array_like
+        ``(num_states, num_controls, slots)`` float probabilities.
+    counts : array_like or None
+        Dirichlet counts in the same layout (no dense ``(n, n, u)`` pB needed), or None.
     """
 
     succ: Any
@@ -70,11 +107,24 @@ class SparseB:
 
 @dataclass(frozen=True)
 class SparseA:
-    """A likelihood over one factor given by its Dirichlet counts, never as a dense array:
-    column ``s`` has a symmetric prior of total concentration ``prior[s]`` spread evenly over
-    the outcomes, plus learned ``counts`` at the ``(outcomes[i], states[i])`` pairs. ``A`` is
-    the normalised counts. Growth and learning cost O(1) per step
-    (:class:`~cogmap.genmodel.likelihood.SparseLikelihood`)."""
+    """A likelihood over one factor given by its Dirichlet counts, never as a dense array.
+
+    Column ``s`` has a symmetric prior of total concentration ``prior[s]`` spread evenly over the
+    outcomes, plus learned ``counts`` at the ``(outcomes[i], states[i])`` pairs. ``A`` is the
+    normalised counts. Growth and learning cost O(1) per step
+    (:class:`~cogmap.genmodel.likelihood.SparseLikelihood`).
+
+    Attributes
+    ----------
+    prior : array_like
+        ``(num_states,)`` float, total prior concentration of each column.
+    outcomes : array_like
+        ``(k,)`` int outcome index of each learned count.
+    states : array_like
+        ``(k,)`` int state index of each learned count.
+    counts : array_like
+        ``(k,)`` float learned counts.
+    """
 
     prior: Any
     outcomes: Any = ()
@@ -86,9 +136,24 @@ class SparseA:
 class PoseSpec:
     """AIMAPP's metric pose model for one factor (B_p and A_p).
 
-    ``poses[s]`` is the stored 2-D pose of state ``s``; ``headings`` are the action directions
-    (radians, one per non-stay control); a move predicts ``pose + step * (cos h, sin h)``.
-    A pose observation is the index of the stored pose within ``influence_radius``.
+    A move predicts ``pose + step * (cos h, sin h)``; a pose observation is the index of the stored
+    pose within ``influence_radius``.
+
+    Attributes
+    ----------
+    factor : str
+        Name of the factor whose states carry poses.
+    poses : array_like
+        ``(size, 2)`` float, metres, world frame: the stored pose of each initial state.
+    headings : array_like
+        ``(num_moves,)`` float radians, one per non-stay control.
+    step : float
+        Length (metres) of one move, default 1.
+    influence_radius : float
+        Radius (metres) of a state's neighbourhood, default 1 (Table 6 of the AIMAPP paper: 1 m
+        small, 2 m large environments).
+    sigma : float or None
+        Width (metres) of the Gaussian pose likelihood; defaults to ``influence_radius / 2``.
     """
 
     factor: str
@@ -101,7 +166,18 @@ class PoseSpec:
 
 @dataclass(frozen=True)
 class InductiveSpec:
-    """Settings of the inductive term H (Eq. 9): reachability threshold, depth, weight."""
+    """Settings of the inductive term H (Eq. 9 of the AIMAPP paper).
+
+    Attributes
+    ----------
+    threshold : float
+        Transition probability in [0, 1] above which a move counts as believed possible, default 0.5.
+    depth : int
+        Horizon in believed-possible moves: goals farther away are ignored; at least 1, default 10
+        (also the default MCTS depth of :func:`cogmap.planning.decide`).
+    weight : float
+        Weight of the term in the expected free energy, default 1.
+    """
 
     threshold: float = 0.5
     depth: int = 10
@@ -110,7 +186,37 @@ class InductiveSpec:
 
 @dataclass
 class ModelSpec:
-    """A generative model as named factor specifications (see module docstring)."""
+    """A generative model as named factor specifications (see the module docstring for array layouts).
+
+    Attributes
+    ----------
+    factors : list of Factor
+        Hidden-state factors.
+    modalities : list of Modality
+        Observation modalities.
+    A : dict
+        Modality name -> ``(size, *sizes of depends_on)`` float likelihood (columns sum to 1) or a
+        :class:`SparseA`.
+    B : dict
+        Factor name -> ``(size, size, num_controls)`` float transitions ``B[next, current, control]``
+        or a :class:`SparseB`.
+    C : dict
+        Modality name -> ``(size,)`` float log-preferences over outcomes (default 0).
+    D : dict
+        Factor name -> ``(size,)`` float initial belief, sums to 1 (default uniform).
+    pA : dict
+        Modality name -> Dirichlet counts shaped as ``A`` (makes the likelihood learnable).
+    pB : dict
+        Factor name -> Dirichlet counts shaped as dense ``B``.
+    C_states : dict
+        Factor name -> ``(size,)`` float log-preferences over states (default 0).
+    pose : PoseSpec or None
+        Metric pose model of one factor.
+    inductive : InductiveSpec or None
+        Settings of the inductive term.
+    collision_preference : float or None
+        Log-preference against a collision outcome.
+    """
 
     factors: list[Factor]
     modalities: list[Modality]

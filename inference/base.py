@@ -51,10 +51,17 @@ class InferenceError(ValueError):
 class InferenceInfo(NamedTuple):
     """What a scheme reports beside the posterior.
 
-    ``free_energy``: variational free energy of the last step in nats (for exact Bayes,
-    ``-log p(o_T | o_<T)``). ``history``: per-time tuples of per-factor beliefs (filtered or
-    smoothed, as the scheme documents). ``iterations``: update sweeps used at the last step.
-    ``total_free_energy``: free energy of the whole sequence (``-log p(o_1:T)`` for exact Bayes).
+    Attributes
+    ----------
+    free_energy : float
+        Variational free energy of the last step in nats (for exact Bayes,
+        ``-log p(o_T | o_<T)``).
+    history : tuple
+        Per-time tuples of per-factor beliefs (filtered or smoothed, as the scheme documents).
+    iterations : int
+        Update sweeps used at the last step.
+    total_free_energy : float or None
+        Free energy of the whole sequence in nats (``-log p(o_1:T)`` for exact Bayes), or None.
     """
 
     free_energy: float
@@ -69,6 +76,17 @@ class Evidence:
 
     The true likelihood is ``lik * exp(log_scale)``; ``lik`` is rescaled to max 1 where that
     avoids underflow (pose evidence far from every stored pose).
+
+    Attributes
+    ----------
+    deps : tuple of int
+        Factor indices the likelihood depends on (the axes of ``lik``).
+    lik : numpy.ndarray
+        Float likelihood, shaped as the live states of ``deps``.
+    log_scale : float
+        Log of the factor ``lik`` was divided by (0 when not rescaled).
+    name : str
+        Name of the modality (or ``"pose"``) it came from.
     """
 
     deps: tuple[int, ...]
@@ -79,7 +97,19 @@ class Evidence:
 
 @dataclass(frozen=True)
 class Problem:
-    """Checked inputs on live slices: ``prior[f]``, ``evidence[t]``, ``actions[t]``."""
+    """Checked inputs of a scheme on live slices, as built by :func:`prepare`.
+
+    Attributes
+    ----------
+    sizes : tuple of int
+        Live states per factor.
+    prior : tuple of numpy.ndarray
+        ``(sizes[f],)`` float prior per factor, each summing to 1.
+    evidence : tuple of tuple of Evidence
+        Per time step, the evidence of every modality (and pose) that reported.
+    actions : tuple of tuple of int
+        ``T - 1`` control tuples, one integer per factor.
+    """
 
     sizes: tuple[int, ...]
     prior: tuple[np.ndarray, ...]
@@ -88,10 +118,12 @@ class Problem:
 
     @property
     def T(self) -> int:  # noqa: N802 - conventional name
+        """Number of time steps."""
         return len(self.evidence)
 
     @property
     def num_factors(self) -> int:
+        """Number of factors."""
         return len(self.sizes)
 
 
@@ -258,6 +290,32 @@ def prepare(model, prior, observations, actions=None) -> Problem:
     """Check a scheme's inputs and turn observations into :class:`Evidence` on live slices.
 
     User-written schemes can call this to get the same checks and conventions as ours.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model (:func:`cogmap.genmodel.compile`).
+    prior : list of numpy.ndarray
+        One belief per factor at the first step, before its observation: ``(num_states[f],)`` float
+        (or capacity length with no mass beyond the live states), sums to 1.
+    observations : sequence
+        ``T >= 1`` steps; each a list with one entry per modality (plus the metric pose ``(x, y)``
+        in metres when the model has a pose factor) or a dict keyed by modality name (and
+        ``"pose"``). An entry is an outcome index, a distribution over the live outcomes, or None
+        (missing). See :mod:`cogmap.inference.base`.
+    actions : sequence, optional
+        ``T - 1`` control tuples, one integer per factor (a bare int for one factor); may be omitted
+        when every factor has a single control.
+
+    Returns
+    -------
+    Problem
+
+    Raises
+    ------
+    InferenceError
+        Naming the argument and the problem (wrong lengths, unnormalised or negative beliefs,
+        outcome indices out of range, bad controls, a pose without a pose factor).
     """
     priors = check_prior(model, prior)
     if isinstance(observations, str | bytes) or not hasattr(observations, "__len__"):
@@ -304,5 +362,20 @@ def expected_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs) -> float:
 
 
 def predict_factorised(model, qs, action) -> list[np.ndarray]:
-    """Per-factor one-step prediction ``B[f][:, :, u_f] q_f`` (dense or sparse)."""
+    """Per-factor one-step prediction ``B[f][:, :, u_f] q_f`` (dense or sparse storage).
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model.
+    qs : sequence of numpy.ndarray
+        ``(n_f,)`` float belief per factor.
+    action : sequence of int
+        One control per factor.
+
+    Returns
+    -------
+    list of numpy.ndarray
+        ``(n_f,)`` float predicted belief per factor.
+    """
     return [model.predict(f, q, int(u)) for f, (q, u) in enumerate(zip(qs, action, strict=True))]

@@ -28,7 +28,41 @@ def _log_space_update(prior, evidence, t):
 
 
 def bayes_filter(model, prior, observations, actions=None):
-    """Single-factor forward filter; ``info.free_energy`` is ``-log p(o_T | o_<T)``."""
+    """AIMAPP's single-factor forward Bayes filter (exact Bayes for one factor).
+
+    Each step predicts through ``B``, multiplies by the likelihood of every reported modality (and
+    the pose kernel) and normalises; an underflowing product is redone in log space.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled single-factor model (dense or sparse, possibly grown).
+    prior : list of numpy.ndarray
+        One belief per factor at the first step, before its observation: ``(num_states[f],)`` float
+        (or capacity length with no mass beyond the live states), sums to 1.
+    observations : sequence
+        ``T >= 1`` steps; each a list with one entry per modality (plus the metric pose ``(x, y)``
+        in metres when the model has a pose factor) or a dict keyed by modality name (and
+        ``"pose"``). An entry is an outcome index, a distribution over the live outcomes, or None
+        (missing). See :mod:`cogmap.inference.base`.
+    actions : sequence, optional
+        ``T - 1`` control tuples, one integer per factor (a bare int for one factor); may be omitted
+        when every factor has a single control.
+
+    Returns
+    -------
+    posterior : list of numpy.ndarray
+        ``(num_states[f],)`` float belief per factor at the last step, each summing to 1.
+    info : InferenceInfo
+        ``free_energy`` is ``-log p(o_T | o_<T)``, ``total_free_energy`` ``-log p(o_1:T)``,
+        ``history`` the filtered beliefs, ``iterations`` 1.
+
+    Raises
+    ------
+    InferenceError
+        If the model has more than one factor, the inputs are invalid (:func:`prepare`), or the
+        observations have zero probability under the model.
+    """
     if len(model.factors) != 1:
         raise InferenceError(
             f"filter: handles single-factor models only (this one has {len(model.factors)} "

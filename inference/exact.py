@@ -43,9 +43,39 @@ def _marginals(joint: np.ndarray) -> tuple[np.ndarray, ...]:
 def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_joint: int = MAX_JOINT):
     """Exact Bayes over the joint state space (the prior is taken as a product of factors).
 
-    ``info.history`` holds smoothed marginals (``smooth=True``) or filtered ones.
-    Raises :class:`InferenceError` when the joint has more than ``max_joint`` states or the
-    observations have zero probability under the model.
+    Parameters
+    ----------
+    model : Model
+        Compiled model (:func:`cogmap.genmodel.compile`).
+    prior : list of numpy.ndarray
+        One belief per factor at the first step, before its observation: ``(num_states[f],)`` float
+        (or capacity length with no mass beyond the live states), sums to 1.
+    observations : sequence
+        ``T >= 1`` steps; each a list with one entry per modality (plus the metric pose ``(x, y)``
+        in metres when the model has a pose factor) or a dict keyed by modality name (and
+        ``"pose"``). An entry is an outcome index, a distribution over the live outcomes, or None
+        (missing). See :mod:`cogmap.inference.base`.
+    actions : sequence, optional
+        ``T - 1`` control tuples, one integer per factor (a bare int for one factor); may be omitted
+        when every factor has a single control.
+    smooth : bool, optional
+        Whether ``info.history`` holds smoothed (forward-backward) marginals (default) or filtered ones.
+    max_joint : int, optional
+        Largest joint state space accepted.
+
+    Returns
+    -------
+    posterior : list of numpy.ndarray
+        ``(num_states[f],)`` float belief per factor at the last step, each summing to 1.
+    info : InferenceInfo
+        ``free_energy`` is ``-log p(o_T | o_<T)``, ``total_free_energy`` ``-log p(o_1:T)``;
+        ``history`` holds per-step marginals of every factor.
+
+    Raises
+    ------
+    InferenceError
+        When the joint has more than ``max_joint`` states, the inputs are invalid, or the
+        observations have zero probability under the model.
     """
     prob = prepare(model, prior, observations, actions)
     sizes = prob.sizes

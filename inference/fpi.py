@@ -65,10 +65,44 @@ def fpi_step(prior, evidence, num_iter: int = 16, tol: float | None = None):
 
 
 def fpi(model, prior, observations, actions=None, *, num_iter: int = 16, tol: float | None = None):
-    """Mean-field fixed-point iteration, filtered over time.
+    """Mean-field fixed-point iteration, filtered over time (pymdp 1.0's ``fpi``).
 
-    ``num_iter`` sweeps per step (pymdp's default 16); ``tol`` stops early when no belief moves
-    by more than ``tol`` (off by default, to keep pymdp's schedule exactly).
+    Each step's prior is the previous posterior predicted through ``B``; ``num_iter`` sweeps update
+    each factor's belief given the others.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model (:func:`cogmap.genmodel.compile`).
+    prior : list of numpy.ndarray
+        One belief per factor at the first step, before its observation: ``(num_states[f],)`` float
+        (or capacity length with no mass beyond the live states), sums to 1.
+    observations : sequence
+        ``T >= 1`` steps; each a list with one entry per modality (plus the metric pose ``(x, y)``
+        in metres when the model has a pose factor) or a dict keyed by modality name (and
+        ``"pose"``). An entry is an outcome index, a distribution over the live outcomes, or None
+        (missing). See :mod:`cogmap.inference.base`.
+    actions : sequence, optional
+        ``T - 1`` control tuples, one integer per factor (a bare int for one factor); may be omitted
+        when every factor has a single control.
+    num_iter : int, optional
+        Sweeps per step, an integer >= 1 (pymdp's default 16).
+    tol : float, optional
+        Stop early when no belief moves by more than ``tol`` (off by default, to keep pymdp's
+        schedule exactly).
+
+    Returns
+    -------
+    posterior : list of numpy.ndarray
+        ``(num_states[f],)`` float belief per factor at the last step, each summing to 1.
+    info : InferenceInfo
+        ``free_energy`` is the mean-field free energy of the last step, ``total_free_energy`` the
+        sum over steps, ``history`` the filtered beliefs, ``iterations`` the sweeps of the last step.
+
+    Raises
+    ------
+    InferenceError
+        If ``num_iter`` is not an integer >= 1 or the inputs are invalid.
     """
     num_iter = check_num_iter(num_iter, "fpi")
     prob = prepare(model, prior, observations, actions)

@@ -42,7 +42,40 @@ def free_energy_terms(model, prob, prior, marginals, start: int = 0) -> np.ndarr
 
 
 def window_free_energy(model, prior, observations, actions, marginals) -> float:
-    """``F[q]`` above for ``marginals[t][f]`` (live sizes) over the whole ``observations``."""
+    """Mean-field variational free energy ``F[q]`` of a whole window under given marginals.
+
+    Comparable across schemes: an upper bound on ``-log p(o_1:T)`` for any marginals (see the module
+    docstring for the formula).
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model (:func:`cogmap.genmodel.compile`).
+    prior : list of numpy.ndarray
+        One belief per factor at the first step, before its observation: ``(num_states[f],)`` float
+        (or capacity length with no mass beyond the live states), sums to 1.
+    observations : sequence
+        ``T >= 1`` steps; each a list with one entry per modality (plus the metric pose ``(x, y)``
+        in metres when the model has a pose factor) or a dict keyed by modality name (and
+        ``"pose"``). An entry is an outcome index, a distribution over the live outcomes, or None
+        (missing). See :mod:`cogmap.inference.base`.
+    actions : sequence, optional
+        ``T - 1`` control tuples, one integer per factor (a bare int for one factor); may be omitted
+        when every factor has a single control.
+    marginals : sequence
+        ``T`` entries, each a sequence of ``(num_states[f],)`` float marginals per factor.
+
+    Returns
+    -------
+    float
+        ``F[q]`` in nats.
+
+    Raises
+    ------
+    ValueError
+        If ``marginals`` does not cover the ``T`` steps of ``observations`` (or the inputs are invalid,
+        :class:`InferenceError`).
+    """
     prob = prepare(model, prior, observations, actions)
     if len(marginals) != prob.T:
         raise ValueError(f"marginals cover {len(marginals)} steps, the observations {prob.T}")

@@ -89,10 +89,40 @@ def _check(model, prior, observations):
 
 
 def kernel_filter(model: KernelBeliefModel, prior, observations, actions=None, **options):
-    """Kernel-belief filtering over a sequence of continuous observations (see the module doc).
+    """Kernel-belief filtering of the drone's binned factors over continuous observations.
 
-    ``actions`` is accepted for the common signature and ignored: the drone's factors are
-    re-observed directly every step, the original has no transition model here.
+    For each factor with observed value ``o``: ``L_i = exp(-1/2 ((bin_i - o) / w)^2)`` (wrapped for
+    azimuth), normalised, then ``b = (1 - rate) b + rate L``; the distance factor is then reweighted
+    by :func:`target_weighting` (see the module docstring, DRONE.md 2.4).
+
+    Parameters
+    ----------
+    model : KernelBeliefModel
+        The binned factors, kernel widths and update rate.
+    prior : list of numpy.ndarray or None
+        ``(n_bins,)`` float belief per factor (each sums to 1), or None for the published per-call
+        re-initialisation (uniform plus one update with the first observation).
+    observations : sequence of dict
+        Non-empty; each ``{factor name: value}`` (metres for distance, radians for angles); absent
+        factors are not updated.
+    actions : optional
+        Accepted for the common signature and ignored (no transition model).
+    **options
+        Ignored.
+
+    Returns
+    -------
+    posterior : list of numpy.ndarray
+        ``(n_bins,)`` float belief per factor, each summing to 1.
+    info : InferenceInfo
+        ``free_energy`` is ``-sum_f log sum_i b_i L_i`` of the last observation (unnormalised
+        kernels), ``history`` the beliefs after each step.
+
+    Raises
+    ------
+    InferenceError
+        For a model of another type, an empty or malformed observation sequence, unknown factor
+        names, non-finite values, or a prior that is not a distribution per factor.
     """
     beliefs = _check(model, prior, observations)
     observations = list(observations)

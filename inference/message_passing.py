@@ -100,9 +100,41 @@ def _window_scheme(kind: str):
 
     scheme.__name__ = kind
     scheme.__qualname__ = kind
-    scheme.__doc__ = (
-        f"{kind.upper()} over a window (see module docstring); options num_iter, tau, window."
-    )
+    scheme.__doc__ = f"""{kind.upper()} over a window of time steps (see the module docstring).
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model (:func:`cogmap.genmodel.compile`).
+    prior : list of numpy.ndarray
+        One belief per factor at the first step, before its observation: ``(num_states[f],)``
+        float, sums to 1.
+    observations : sequence
+        ``T >= 1`` steps, as for every scheme (:mod:`cogmap.inference.base`).
+    actions : sequence, optional
+        ``T - 1`` control tuples, one integer per factor.
+    num_iter : int, optional
+        Simultaneous update sweeps, an integer >= 1 (default 16, as pymdp 1.0).
+    tau : float, optional
+        Step size of each update, default 1.
+    window : int, optional
+        Number of last steps smoothed together (>= 1); the steps before are filtered by
+        fixed-point iteration. Default None: the whole sequence.
+
+    Returns
+    -------
+    posterior : list of numpy.ndarray
+        ``(num_states[f],)`` float belief per factor at the last step.
+    info : InferenceInfo
+        ``total_free_energy`` is the mean-field free energy of the window, ``free_energy`` its
+        terms that involve the last step, ``history`` the smoothed beliefs of the window
+        (filtered ones before it), ``iterations`` ``num_iter``.
+
+    Raises
+    ------
+    InferenceError
+        If ``num_iter`` or ``window`` is invalid, or the inputs are (:func:`prepare`).
+    """
     return scheme
 
 

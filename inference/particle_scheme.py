@@ -25,11 +25,52 @@ from .base import InferenceError, InferenceInfo
 
 
 class ParticleModel(NamedTuple):
+    """A continuous-state model for the ``"particle_filter"`` scheme (two pure JAX functions).
+
+    Attributes
+    ----------
+    transition : callable
+        ``transition(key, particles (K, D), control) -> (K, D)`` samples the next particles.
+    log_likelihood : callable
+        ``log_likelihood(particles (K, D), observation) -> (K,)`` log-likelihood of each particle.
+    """
     transition: Callable
     log_likelihood: Callable
 
 
 def particle_filter(model, prior, observations, actions=None, *, num_particles: int = 1000, seed: int = 0):
+    """Bootstrap particle filter as an inference scheme (jax is imported on the first call).
+
+    Parameters
+    ----------
+    model : ParticleModel
+        Transition sampler and log-likelihood.
+    prior : numpy.ndarray or tuple
+        Initial particles ``(K, D)``, or ``(mean, std)`` (each ``(D,)``) from which ``num_particles``
+        are drawn.
+    observations : array_like
+        ``(T, ...)`` float, ``T >= 1`` observations.
+    actions : array_like, optional
+        ``(T - 1, ...)`` controls; required when ``T > 1``.
+    num_particles : int, optional
+        Particles drawn from a ``(mean, std)`` prior, default 1000.
+    seed : int, optional
+        Seed of the JAX random key, default 0.
+
+    Returns
+    -------
+    posterior : tuple of numpy.ndarray
+        ``(particles (K, D), weights (K,))`` at the last step.
+    info : InferenceInfo
+        ``history`` holds one ``(mean, std)`` pair per step, ``free_energy`` is the estimate of
+        ``-log p(x_T | x_<T)`` and ``total_free_energy`` of ``-log p(x_1:T)``.
+
+    Raises
+    ------
+    InferenceError
+        For a model of another type, empty observations, a malformed prior, or a wrong number of
+        actions.
+    """
     if not isinstance(model, ParticleModel):
         raise InferenceError("particle_filter: model must be a ParticleModel(transition, log_likelihood)")
     import jax

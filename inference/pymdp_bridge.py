@@ -9,9 +9,24 @@ def to_pymdp(model, **agent_kwargs):
     """A pymdp 1.0 ``Agent`` holding the live slices of ``model`` with a batch axis of 1.
 
     ``A``, ``B`` (dense, also from sparse storage), ``C``, ``D``, ``A_dependencies`` and, when
-    present, ``pA`` / ``pB`` are passed; ``agent_kwargs`` go to ``Agent`` unchanged (for example
-    ``inference_algo="mmp"``, ``num_iter=16``). Arrays use JAX's default float type (enable
-    ``jax_enable_x64`` for double precision). Requires the ``pymdp`` extra.
+    present for every modality/factor, ``pA`` / ``pB`` are passed. Arrays use JAX's default float
+    type (enable ``jax_enable_x64`` for double precision). Requires the ``pymdp`` extra.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model.
+    **agent_kwargs
+        Passed to ``Agent`` unchanged (for example ``inference_algo="mmp"``, ``num_iter=16``).
+
+    Returns
+    -------
+    pymdp.agent.Agent
+
+    Raises
+    ------
+    ImportError
+        If pymdp 1.0 is not installed.
     """
     try:
         import jax.numpy as jnp

@@ -13,7 +13,32 @@ _SCHEMES: dict[str, Callable] = {}
 
 
 def register(name: str, fn: Callable | None = None, *, overwrite: bool = False):
-    """Register ``fn`` under ``name``; usable as a decorator (``@register("mine")``)."""
+    """Register an inference scheme under ``name``; usable as a decorator (``@register("mine")``).
+
+    A scheme is any callable ``scheme(model, prior, observations, actions=None, **options)``
+    returning ``(posterior, info)``.
+
+    Parameters
+    ----------
+    name : str
+        Non-empty name.
+    fn : callable, optional
+        The scheme; omit to get a decorator.
+    overwrite : bool, optional
+        Whether to replace another scheme of the same name, default False.
+
+    Returns
+    -------
+    callable
+        ``fn`` itself, or a decorator that registers and returns its argument.
+
+    Raises
+    ------
+    ValueError
+        For an empty name, or a name taken by another scheme without ``overwrite``.
+    TypeError
+        If the scheme is not callable.
+    """
     if not isinstance(name, str) or not name:
         raise ValueError("register: name must be a non-empty string")
 
@@ -29,12 +54,41 @@ def register(name: str, fn: Callable | None = None, *, overwrite: bool = False):
 
 
 def unregister(name: str) -> None:
+    """Remove the scheme registered under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        Registered name.
+
+    Raises
+    ------
+    KeyError
+        If no scheme has that name.
+    """
     if name not in _SCHEMES:
         raise KeyError(f"no inference scheme named '{name}'")
     del _SCHEMES[name]
 
 
 def get(name: str) -> Callable:
+    """The scheme registered under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        Registered name (``available()`` lists them).
+
+    Returns
+    -------
+    callable
+        ``scheme(model, prior, observations, actions=None, **options) -> (posterior, info)``.
+
+    Raises
+    ------
+    KeyError
+        If no scheme has that name (the message lists the available ones).
+    """
     try:
         return _SCHEMES[name]
     except KeyError:
@@ -42,4 +96,11 @@ def get(name: str) -> Callable:
 
 
 def available() -> tuple[str, ...]:
+    """Names of the registered schemes.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names.
+    """
     return tuple(sorted(_SCHEMES))

@@ -25,6 +25,53 @@ from .efe import EPS, entropy, novelty_weights
 
 @dataclass(frozen=True)
 class PlanningArrays:
+    """A model's arrays (pymdp layout, no batch axis) and the planning inputs that are not part of the model.
+
+    Arrays may be at a capacity larger than the live sizes: planning only reads live entries. Raw
+    ``A``/``B`` arrays are wrapped on construction into :class:`DenseLikelihood` /
+    :class:`DenseTransitions` with ``pA``/``pB`` as their counts (``pA``/``pB`` are then None).
+
+    Attributes
+    ----------
+    A : list
+        Per modality, a likelihood object or ``(obs_cap, *state_caps[deps])`` float array.
+    A_deps : tuple of tuple of int
+        Factors each modality depends on.
+    B : list
+        Per factor, a transition object or ``(cap, cap, num_controls)`` float array.
+    C : list of numpy.ndarray
+        Per modality, ``(obs_cap,)`` float log-preferences.
+    num_states, num_obs, num_controls : tuple of int
+        Live states per factor, live outcomes per modality, controls per factor.
+    C_states : list of numpy.ndarray or None
+        Per factor, ``(state_cap,)`` float log-preferences over states.
+    pA, pB : list or None
+        Counts for raw ``A`` / dense ``B`` arrays only.
+    stay : tuple or None
+        Stay control of each factor (or None).
+    poses : numpy.ndarray or None
+        ``(state_cap, 2)`` float stored poses of ``pose_factor``, metres, world frame.
+    pose_factor : int
+        Factor carrying poses, default 0.
+    pose_sigma : float
+        Width (metres) of the position preference, default 1.
+    target_pose : numpy.ndarray or None
+        ``(2,)`` float target position (metres) for :func:`position_preference`.
+    goal_states : numpy.ndarray or None
+        Int preferred states of ``goal_factor`` for the inductive term.
+    goal_factor : int
+        Factor of the goal states, default 0.
+    inductive_threshold : float
+        Transition probability above which a move counts as possible (inductive term), default 0.5.
+    inductive_depth : int
+        Horizon of the inductive term, default 10.
+    collision_pref : float
+        Log-preference of a collision (no collision: 0), default -10.
+    control_factor : int
+        Factor whose controls the obstacle signal refers to, default 0.
+    view : numpy.ndarray or None
+        Per state of ``pose_factor``, the unseen fraction of its view, in [0, 1].
+    """
     A: list  # A[m]: (obs_cap, *state_caps[deps]); live part [:num_obs[m], :num_states...]
     A_deps: tuple
     B: list  # DenseTransitions / SparseTransitions (raw (cap, cap, u) arrays are wrapped, with pB)
@@ -66,22 +113,81 @@ class PlanningArrays:
 
     @property
     def num_factors(self) -> int:
+        """Number of factors."""
         return len(self.B)
 
     def is_sparse(self, f: int) -> bool:
+        """Whether factor ``f`` has sparse transitions.
+
+        Parameters
+        ----------
+        f : int
+            Factor index.
+
+        Returns
+        -------
+        bool
+        """
         return isinstance(self.B[f], SparseTransitions)
 
     def live_A(self, m: int) -> np.ndarray:
-        """Dense live ``A[m]`` (a sparse likelihood is densified: small models only)."""
+        """Dense live ``A[m]`` (a sparse likelihood is densified: small models only).
+
+        Parameters
+        ----------
+        m : int
+            Modality index.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(num_obs[m], *live states of its dependencies)`` float.
+        """
         return self.A[m].to_dense()
 
     def live_B(self, f: int) -> np.ndarray:
+        """Dense live ``B[f]``.
+
+        Parameters
+        ----------
+        f : int
+            Factor index.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n, n, num_controls[f])`` float with ``n = num_states[f]``.
+        """
         return self.B[f].to_dense(self.num_states[f])
 
     def live_pA(self, m: int):
+        """Live Dirichlet counts of ``A[m]`` (None without counts).
+
+        Parameters
+        ----------
+        m : int
+            Modality index.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            Shaped as :meth:`live_A`.
+        """
         return self.A[m].counts_dense()
 
     def live_pB(self, f: int):
+        """Live Dirichlet counts of ``B[f]`` (None without counts).
+
+        Parameters
+        ----------
+        f : int
+            Factor index.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(n, n, num_controls[f])`` float.
+        """
         B = self.B[f]
         return None if B.counts is None else B.counts_dense(self.num_states[f])
 
@@ -95,11 +201,30 @@ def from_model(
     collision_pref: float | None = None,
     view=None,
 ) -> PlanningArrays:
-    """Adapter: the arrays of a compiled ``cogmap.genmodel.Model`` (views, nothing copied).
+    """Adapter: the arrays of a compiled :class:`cogmap.genmodel.Model` (views, nothing copied).
 
     Goal states for the inductive term default to the states of maximal positive ``C_states``
     (none when ``C_states`` is flat) and, with a target pose, the stored pose nearest to it
     (within the influence radius).
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model.
+    target_pose : array_like, optional
+        ``(2,)`` float target position, metres.
+    goal_states : array_like, optional
+        Int preferred states (overrides the defaults above).
+    goal_factor : int, optional
+        Factor of the goal states; default the pose factor (or 0).
+    collision_pref : float, optional
+        Log-preference of a collision; default the model's ``collision_preference``, else -10.
+    view : array_like, optional
+        Per state, the unseen fraction of its view, in [0, 1].
+
+    Returns
+    -------
+    PlanningArrays
     """
     pose = model.pose
     pf = pose.factor if pose is not None else 0
@@ -152,7 +277,30 @@ def as_arrays(model) -> PlanningArrays:
 
 @dataclass
 class Prepared:
-    """Derived quantities for one decision (dense: full arrays; local: per-state caches)."""
+    """Derived quantities for one decision (dense: full arrays; local: per-state caches).
+
+    Built by :func:`prepare`.
+
+    Attributes
+    ----------
+    arrays : PlanningArrays
+        The planning inputs.
+    local : bool
+        Whether this is the local path (one sparse factor, per-state caches).
+    B : list of numpy.ndarray
+        Dense path: live ``(n, n, u)`` transition arrays per factor.
+    HA : list of numpy.ndarray
+        Dense path: column entropies (nats) of each live ``A[m]``.
+    wA : list
+        Dense path: novelty weights of each ``pA[m]`` (or None).
+    wB : list
+        Dense path: novelty weights of each ``pB[f]`` (or None).
+    dist : numpy.ndarray or None
+        Goal distances (in believed-possible moves) of the states of ``goal_factor``; None without
+        a goal.
+    need_novelty : bool
+        Whether novelty weights are computed.
+    """
 
     arrays: PlanningArrays
     local: bool = False  # single sparse factor, per-state caches
@@ -165,9 +313,27 @@ class Prepared:
     _cache: dict = field(default_factory=dict)  # local path, dense likelihoods: modality -> _Columns
 
     def column_stats(self, m: int, U: np.ndarray):
-        """``(H, w_bg, w_slots)`` of likelihood ``m`` at states ``U`` (see
-        ``SparseLikelihood.column_stats``). A sparse likelihood computes them in O(slots) per
-        state; a dense one in O(outcomes), so they are kept for the rest of the decision."""
+        """``(H, w_bg, w_slots)`` of likelihood ``m`` at states ``U`` (see ``SparseLikelihood.column_stats``).
+
+        A sparse likelihood computes them in O(slots) per state; a dense one in O(outcomes), so they are
+        kept for the rest of the decision.
+
+        Parameters
+        ----------
+        m : int
+            Modality index.
+        U : numpy.ndarray
+            ``(U,)`` int state indices.
+
+        Returns
+        -------
+        H : numpy.ndarray
+            ``(U,)`` float column entropies.
+        w_bg : numpy.ndarray
+            ``(U,)`` float background novelty weights.
+        w_slots : numpy.ndarray
+            ``(U, slots)`` float novelty weight of each slot (each outcome for a dense likelihood).
+        """
         A = self.arrays.A[m]
         novelty = self.need_novelty and A.has_counts
         if isinstance(A, SparseLikelihood):
@@ -213,9 +379,29 @@ def prepare(
     need_novelty: bool = True,
     need_goal: bool = True,
 ) -> Prepared:
-    """Per-decision derived arrays (see module docstring). ``local`` (default: one sparse
-    factor) selects the per-state caches of the local path; otherwise everything is dense
-    (sparse transitions are densified: small models only)."""
+    """Per-decision derived arrays: column entropies, novelty weights and goal distances.
+
+    Parameters
+    ----------
+    arrays : PlanningArrays
+        The planning inputs.
+    local : bool, optional
+        Use the local path's per-state caches; default: when there is one sparse factor. Otherwise
+        everything is dense (sparse transitions are densified: small models only).
+    need_novelty : bool, optional
+        Whether to compute the novelty weights, default True.
+    need_goal : bool, optional
+        Whether to compute goal distances for the inductive term, default True.
+
+    Returns
+    -------
+    Prepared
+
+    Raises
+    ------
+    ValueError
+        If ``local`` is True but the arrays are not a single factor with sparse transitions.
+    """
     a = arrays
     if local is None:
         local = a.num_factors == 1 and a.is_sparse(0)

@@ -64,10 +64,35 @@ def sparse_graph_edges(B, poses: np.ndarray, n: int, threshold: float = 0.5) -> 
 
 
 def astar_graph(graph, start, goal, poses=None, threshold: float = 0.5, weight: str = "weight"):
-    """Shortest path on a cognitive map. ``graph`` is a networkx graph (edge ``weight``
-    attribute, else the distance between node ``pose`` attributes / ``poses``) or sparse
-    a transition factor, dense or sparse (then ``poses`` is required). Returns ``(path, cost)``,
-    ``(None, inf)`` when unreachable."""
+    """Shortest path on a cognitive map with A* (straight-line heuristic between poses).
+
+    Parameters
+    ----------
+    graph : networkx.Graph or DenseTransitions or SparseTransitions
+        A networkx graph (edge attribute ``weight``, else the distance between node ``pose``
+        attributes / ``poses``, else 1), or a transition factor whose edges above ``threshold`` are
+        weighted by the metric distance between stored poses (then ``poses`` is required).
+    start, goal : hashable
+        Start and goal nodes (state indices for a transition factor).
+    poses : array_like, optional
+        ``(n, 2)`` float stored poses, metres; used instead of node ``pose`` attributes.
+    threshold : float, optional
+        Transition probability above which a move is an edge (transition factors), default 0.5.
+    weight : str, optional
+        Name of the edge weight attribute (networkx graphs), default ``"weight"``.
+
+    Returns
+    -------
+    path : list or None
+        Nodes from ``start`` to ``goal``, or None when unreachable.
+    cost : float
+        Path length (metres for metric weights), ``inf`` when unreachable.
+
+    Raises
+    ------
+    ValueError
+        If ``graph`` is a transition factor and ``poses`` is missing.
+    """
     if isinstance(graph, DenseTransitions | SparseTransitions):
         if poses is None:
             raise ValueError("astar_graph on a transition factor needs the stored poses")
@@ -108,9 +133,25 @@ _MOVES = [(-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1)]
 
 
 def astar_grid(occupied: np.ndarray, start, goal, resolution: float = 1.0):
-    """8-connected A* on a boolean occupancy grid (``occupied[row, col]``). Diagonal steps
-    may not cut an occupied corner. Returns ``(path as [(row, col), ...], length in metres)``
-    or ``(None, inf)``."""
+    """8-connected A* on a boolean occupancy grid; diagonal steps may not cut an occupied corner.
+
+    Parameters
+    ----------
+    occupied : array_like
+        ``(H, W)`` bool, ``occupied[row, col]`` True where occupied.
+    start, goal : tuple of int
+        ``(row, col)`` cells.
+    resolution : float, optional
+        Cell size in metres, default 1.
+
+    Returns
+    -------
+    path : list of tuple or None
+        Cells ``(row, col)`` from ``start`` to ``goal``; None when unreachable or when an end cell is
+        outside the grid or occupied.
+    length : float
+        Path length in metres (``inf`` when there is no path).
+    """
     occ = np.asarray(occupied, dtype=bool)
     H, W = occ.shape
     start, goal = tuple(int(x) for x in start), tuple(int(x) for x in goal)

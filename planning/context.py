@@ -66,32 +66,55 @@ class _Common:
 
     @property
     def num_candidates(self) -> int:
+        """Number of candidates ``K`` evaluated in this step."""
         return self.actions.shape[0]
 
     @property
     def C(self) -> list:
+        """Per modality, the ``(num_obs[m],)`` float log-preferences over live outcomes."""
         a = self.prep.arrays
         return [a.C[m][: a.num_obs[m]] for m in range(len(a.A))]
 
     @property
     def pose_factor(self) -> int:
+        """Index of the factor carrying poses."""
         return self.prep.arrays.pose_factor
 
     @property
     def pose_sigma(self) -> float:
+        """Width (metres) of the position preference."""
         return self.prep.arrays.pose_sigma
 
     @property
     def target_pose(self):
+        """``(2,)`` float target position (metres) of the position preference, or None."""
         return self.prep.arrays.target_pose
 
     @property
     def collision_pref(self) -> float:
+        """Log-preference of a collision (no collision: 0)."""
         return self.prep.arrays.collision_pref
 
 
 class DenseStep(_Common):
-    """One step from batched beliefs ``qs_prev`` (per factor (K, n_f)) under ``actions`` (K, F)."""
+    """One planning step from batched beliefs ``qs_prev`` under ``actions``, on full (multi-factor) beliefs.
+
+    Predicted beliefs ``qs`` are computed on construction; the other attributes listed in the module
+    docstring are computed on first access.
+
+    Parameters
+    ----------
+    prep : Prepared
+        Derived arrays of the decision (dense path).
+    qs_prev : list of numpy.ndarray
+        Per factor, ``(K, n_f)`` float beliefs before the step, rows sum to 1.
+    actions : numpy.ndarray
+        ``(K, F)`` int, one control per factor for each candidate.
+    t : int, optional
+        Index of the step within the imagined policy, default 0.
+    collision : numpy.ndarray or None, optional
+        ``(K,)`` float probability of a collision per candidate (first step only), or None.
+    """
 
     def __init__(self, prep: Prepared, qs_prev: list, actions: np.ndarray, t: int = 0, collision=None):
         self.prep = prep
@@ -113,24 +136,29 @@ class DenseStep(_Common):
 
     @cached_property
     def qo(self) -> list:
+        """Per modality, ``(K, num_obs[m])`` float predicted outcome distribution of each candidate."""
         a = self._a
         return [expect(a.live_A(m), [self.qs[f] for f in a.A_deps[m]], True) for m in range(len(a.A))]
 
     @cached_property
     def outcome_entropy(self) -> list:
+        """Per modality, ``(K,)`` float entropy (nats) of the predicted outcome distribution."""
         return [entropy(qo, axis=1) for qo in self.qo]
 
     @cached_property
     def outcome_utility(self) -> list:
+        """Per modality, ``(K,)`` float expected log-preference ``Q(o_m) . C_m``."""
         return [qo @ c for qo, c in zip(self.qo, self.C, strict=True)]
 
     @cached_property
     def ambiguity(self) -> list:
+        """Per modality, ``(K,)`` float expected column entropy ``E_Q(s)[H[P(o_m|s)]]`` (nats)."""
         a = self._a
         return [expect(self.prep.HA[m], [self.qs[f] for f in a.A_deps[m]]) for m in range(len(a.A))]
 
     @cached_property
     def a_novelty(self) -> list:
+        """Per modality, ``(K,)`` float information gain about ``A``'s parameters, or None without counts."""
         a = self._a
         out = []
         for m, w in enumerate(self.prep.wA):
@@ -143,6 +171,7 @@ class DenseStep(_Common):
 
     @cached_property
     def b_novelty(self) -> list:
+        """Per factor, ``(K,)`` float information gain about ``B``'s parameters, or None without counts."""
         out = []
         for f, w in enumerate(self.prep.wB):
             if w is None:
@@ -158,6 +187,7 @@ class DenseStep(_Common):
 
     @property
     def C_states(self) -> list:
+        """Per factor, the ``(n_f,)`` float log-preferences over live states (None entries without any)."""
         a = self._a
         if a.C_states is None:
             return [None] * a.num_factors
@@ -165,11 +195,13 @@ class DenseStep(_Common):
 
     @property
     def poses(self):
+        """``(n, 2)`` float stored poses (metres) of the live states of the pose factor, or None."""
         a = self._a
         return None if a.poses is None else a.poses[: a.num_states[a.pose_factor]]
 
     @cached_property
     def view(self):
+        """``(K,)`` float expected unseen fraction of the predicted state's view, or None without a view."""
         v = self._a.view
         if v is None:
             return None
@@ -178,6 +210,11 @@ class DenseStep(_Common):
 
     @cached_property
     def closer(self):
+        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
+
+        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
+        AIMAPP paper).
+        """
         dist = self.prep.dist
         if dist is None:
             return None
@@ -187,8 +224,26 @@ class DenseStep(_Common):
 
 
 class LocalStep(_Common):
-    """One step of a single sparse factor from the sparse prior ``(prior_idx, prior_p)``
-    under each control in ``actions`` (K,)."""
+    """One planning step of a single sparse factor from a sparse prior, restricted to reachable states.
+
+    Every array is over ``U`` (attribute), the states the candidates can reach, so the cost is
+    independent of the size of the map.
+
+    Parameters
+    ----------
+    prep : Prepared
+        Derived quantities of the decision (local path).
+    prior_idx : array_like
+        ``(R,)`` int states with prior mass.
+    prior_p : array_like
+        ``(R,)`` float their probabilities (sum to 1).
+    actions : array_like
+        ``(K,)`` int control of each candidate.
+    t : int, optional
+        Index of the step within the imagined policy, default 0.
+    collision : numpy.ndarray or None, optional
+        ``(K,)`` float probability of a collision per candidate, or None.
+    """
 
     def __init__(self, prep: Prepared, prior_idx, prior_p, actions, t: int = 0, collision=None):
         self.prep = prep
@@ -255,11 +310,13 @@ class LocalStep(_Common):
 
     @cached_property
     def outcome_entropy(self) -> list:
+        """Per modality, ``(K,)`` float entropy (nats) of the predicted outcome distribution."""
         return [-(self._a.num_obs[m] - outcomes.size) * xlogx(bg) - xlogx(values).sum(axis=1)
                 for m, (bg, outcomes, values) in enumerate(self._outcomes)]
 
     @cached_property
     def outcome_utility(self) -> list:
+        """Per modality, ``(K,)`` float expected log-preference ``Q(o_m) . C_m``."""
         a = self._a
         out = []
         for m, (bg, outcomes, values) in enumerate(self._outcomes):
@@ -270,12 +327,16 @@ class LocalStep(_Common):
 
     @cached_property
     def ambiguity(self) -> list:
+        """Per modality, ``(K,)`` float expected column entropy ``E_Q(s)[H[P(o_m|s)]]`` (nats)."""
         return [self.qs[0] @ st[0] for st in self._stats]
 
     @cached_property
     def a_novelty(self) -> list:
-        """``sum_o Q(o) E_Q(s)[W(o, s)]`` from the compressed outcomes: every unlisted outcome
-        shares the background weight of each column; listed slots add their difference."""
+        """Per modality, ``(K,)`` float information gain about ``A``'s parameters, or None without counts.
+
+        ``sum_o Q(o) E_Q(s)[W(o, s)]`` from the compressed outcomes: every unlisted outcome shares the
+        background weight of each column; listed slots add their difference.
+        """
         qs = self.qs[0]
         out = []
         for m, A in enumerate(self._a.A):
@@ -293,6 +354,7 @@ class LocalStep(_Common):
 
     @cached_property
     def b_novelty(self) -> list:
+        """One-element list: ``(K,)`` float information gain about ``B``'s parameters, or None without counts."""
         B = self._a.B[0]
         if getattr(B, "counts", None) is None:
             return [None]
@@ -316,21 +378,29 @@ class LocalStep(_Common):
 
     @cached_property
     def C_states(self) -> list:
+        """One-element list: ``(U,)`` float log-preferences over the reachable states ``U`` (or None)."""
         a = self._a
         return [None if a.C_states is None else a.C_states[0][self.U]]
 
     @cached_property
     def poses(self):
+        """``(U, 2)`` float stored poses (metres) of the reachable states ``U``, or None."""
         a = self._a
         return None if a.poses is None else a.poses[self.U]
 
     @cached_property
     def view(self):
+        """``(K,)`` float expected unseen fraction of the predicted state's view, or None without a view."""
         v = self._a.view
         return None if v is None else self.qs[0] @ v[self.U]
 
     @cached_property
     def closer(self):
+        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
+
+        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
+        AIMAPP paper).
+        """
         dist = self.prep.dist
         if dist is None:
             return None
@@ -341,7 +411,13 @@ class LocalStep(_Common):
         )
 
     def most_likely(self) -> np.ndarray:
-        """Most likely next state per candidate (summing repeated states of a point prior)."""
+        """Most likely next state per candidate (summing repeated states of a point prior).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(K,)`` int state indices.
+        """
         if self._point:
             K = self.num_candidates
             succ = self.U.reshape(K, -1)

@@ -16,7 +16,26 @@ MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full, "sensed
 
 
 def make_objective(mode, inductive_weight: float | None = None) -> efe.Objective:
-    """``mode`` is "explore", "goal", "full" or an :class:`~.efe.Objective`."""
+    """The objective of a planning mode.
+
+    Parameters
+    ----------
+    mode : str or Objective
+        ``"explore"``, ``"goal"``, ``"full"``, ``"sensed"``, ``"pymdp"`` (keys of ``MODES``) or an
+        :class:`~.efe.Objective`, returned as is.
+    inductive_weight : float, optional
+        Weight of the inductive term for ``"goal"``, ``"full"`` and ``"sensed"``; default the
+        preset's.
+
+    Returns
+    -------
+    Objective
+
+    Raises
+    ------
+    ValueError
+        For an unknown mode.
+    """
     if isinstance(mode, efe.Objective):
         return mode
     if mode not in MODES:
@@ -40,13 +59,31 @@ def decide(
 ) -> Decision:
     """Choose the next control by MCTS over EFE.
 
-    ``model`` is a compiled ``cogmap.genmodel.Model`` or :class:`PlanningArrays`; ``qs`` the
-    current belief (a list per factor, or one array for a single factor); ``obstacles`` one
-    bool per control of the moving factor (True: obstacle in that direction); ``mode``
-    "explore", "goal", "full", "sensed" or a custom objective; ``view`` the unseen fraction of
-    each state's view (read by ``efe.sensed_info_gain``), ``goal_states`` the preferred states
-    of the inductive term. Depth and simulations default to the
-    model's inductive depth and 30.
+    Parameters
+    ----------
+    model : Model or PlanningArrays
+        A compiled model or planning arrays.
+    qs : list of numpy.ndarray or numpy.ndarray
+        Current belief, a list per factor or one ``(n,)`` array for a single factor.
+    obstacles : array_like, optional
+        One bool per control of the moving factor (True: obstacle in that direction).
+    mode : str or Objective, optional
+        ``"explore"`` (default), ``"goal"``, ``"full"``, ``"sensed"``, ``"pymdp"`` or a custom
+        objective (:func:`make_objective`).
+    target_pose : array_like, optional
+        ``(2,)`` float target position in metres (position preference, inductive goal).
+    goal_states : array_like, optional
+        Int preferred states of the inductive term.
+    view : array_like, optional
+        Per state, the unseen fraction of its view in [0, 1] (read by ``efe.sensed_info_gain``).
+    config : MCTSConfig, optional
+        Search settings; default depth is the model's inductive depth, 30 simulations.
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed.
+
+    Returns
+    -------
+    Decision
     """
     if isinstance(model, PlanningArrays):
         arrays = model

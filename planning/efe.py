@@ -46,7 +46,22 @@ def novelty_weights(counts: np.ndarray, axis: int = 0) -> np.ndarray:
 
 # -- the six terms of Eq. 6 (plus the inductive term of Eq. 9) ------------------------------
 def state_info_gain(ctx) -> np.ndarray:
-    """Epistemic value about states: ``sum_m H[Q(o_m)] - E_Q(s)[H[P(o_m|s)]]``."""
+    """Epistemic value about states: ``sum_m H[Q(o_m)] - E_Q(s)[H[P(o_m|s)]]``.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    The state information gain of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     out = np.zeros(ctx.num_candidates)
     for h, amb in zip(ctx.outcome_entropy, ctx.ambiguity, strict=True):
         out += h - amb
@@ -63,17 +78,62 @@ def _sum_present(values, n: int) -> np.ndarray:
 
 
 def a_novelty(ctx) -> np.ndarray:
-    """Information gain about likelihood parameters (from ``pA``); zero without counts."""
+    """Information gain about likelihood parameters (from ``pA``); zero without counts.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    Part of the parameter information gain of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     return _sum_present(ctx.a_novelty, ctx.num_candidates)
 
 
 def b_novelty(ctx) -> np.ndarray:
-    """Information gain about transition parameters (from ``pB``); zero without counts."""
+    """Information gain about transition parameters (from ``pB``); zero without counts.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    Part of the parameter information gain of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     return _sum_present(ctx.b_novelty, ctx.num_candidates)
 
 
 def param_info_gain(ctx) -> np.ndarray:
-    """Epistemic value about parameters: A novelty + B novelty."""
+    """Epistemic value about parameters: :func:`a_novelty` + :func:`b_novelty`.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    The parameter information gain of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     return a_novelty(ctx) + b_novelty(ctx)
 
 
@@ -89,7 +149,22 @@ def sensed_info_gain(ctx) -> np.ndarray:
 
 
 def observation_preference(ctx) -> np.ndarray:
-    """Expected log-preference over outcomes, ``sum_m Q(o_m) . C_m``."""
+    """Expected log-preference over outcomes, ``sum_m Q(o_m) . C_m``.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    The preference (utility) term of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     out = np.zeros(ctx.num_candidates)
     for u in ctx.outcome_utility:
         out += u
@@ -97,7 +172,22 @@ def observation_preference(ctx) -> np.ndarray:
 
 
 def state_preference(ctx) -> np.ndarray:
-    """Expected log-preference over states, ``sum_f Q(s_f) . C_states_f``."""
+    """Expected log-preference over states, ``sum_f Q(s_f) . C_states_f``.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    A preference term of Eq. (6) / Table 1 of the AIMAPP paper, over states.
+    """
     out = np.zeros(ctx.num_candidates)
     for qs, c in zip(ctx.qs, ctx.C_states, strict=True):
         if c is not None:
@@ -106,8 +196,24 @@ def state_preference(ctx) -> np.ndarray:
 
 
 def position_preference(ctx) -> np.ndarray:
-    """Expected Gaussian log-preference of the stored pose of the predicted state around a
-    target pose: ``E_Q(s)[-|pose(s) - target|^2 / (2 sigma^2)]``; zero without a target."""
+    """Expected Gaussian log-preference of the predicted state's stored pose around a target pose.
+
+    ``E_Q(s)[-|pose(s) - target|^2 / (2 sigma^2)]`` with poses in metres; zero without a target pose.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    The preference over positions of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     if ctx.target_pose is None or ctx.poses is None:
         return np.zeros(ctx.num_candidates)
     d2 = ((ctx.poses - np.asarray(ctx.target_pose, dtype=float)) ** 2).sum(axis=1)
@@ -115,9 +221,25 @@ def position_preference(ctx) -> np.ndarray:
 
 
 def collision(ctx) -> np.ndarray:
-    """Expected log-preference of the collision outcome: ``P(collision) * ln P~(collision)``
-    (with ``ln P~(no collision) = 0``). ``P(collision)`` comes from the binary per-direction
-    obstacle signal (one flag per control) at the first step, zero afterwards."""
+    """Expected log-preference of the collision outcome: ``P(collision) * ln P~(collision)``.
+
+    ``ln P~(no collision) = 0``. ``P(collision)`` comes from the binary per-direction obstacle
+    signal (one flag per control) at the first step, zero afterwards; zero without a signal.
+
+    Parameters
+    ----------
+    ctx : DenseStep or LocalStep
+        Step context of ``K`` candidates (:mod:`cogmap.planning.context`).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(K,)`` float, nats; higher is better (pymdp's ``neg_efe`` sign).
+
+    Notes
+    -----
+    The collision term of Eq. (6) / Table 1 of the AIMAPP paper.
+    """
     if ctx.collision is None:
         return np.zeros(ctx.num_candidates)
     return ctx.collision * ctx.collision_pref
@@ -153,7 +275,16 @@ EPISTEMIC = (state_info_gain, param_info_gain, a_novelty, b_novelty, sensed_info
 # -- combinator ------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Objective:
-    """Weighted sum of terms; calling it returns the per-step EFE ``G`` per candidate."""
+    """Weighted sum of EFE terms; calling it on a step context returns the per-step EFE per candidate.
+
+    ``objective(ctx)`` returns ``G = -sum_i w_i * term_i(ctx)``, ``(K,)`` float, lower is better;
+    terms with weight 0 are not evaluated.
+
+    Attributes
+    ----------
+    terms : tuple of (callable, float)
+        ``(term, weight)`` pairs; a term maps a step context to a ``(K,)`` array.
+    """
 
     terms: tuple[tuple[Term, float], ...]
 
@@ -165,8 +296,23 @@ class Objective:
         return g
 
     def split(self, ctx) -> tuple[np.ndarray, np.ndarray]:
-        """``(G, G without the epistemic terms)``: the second is the value of a step whose
-        information has already been gained earlier on the same imagined path."""
+        """``(G, G without the epistemic terms)`` per candidate.
+
+        The second is the value of a step whose information has already been gained earlier on the same
+        imagined path (MCTS revisits).
+
+        Parameters
+        ----------
+        ctx : DenseStep or LocalStep
+            Step context of ``K`` candidates.
+
+        Returns
+        -------
+        G : numpy.ndarray
+            ``(K,)`` float expected free energy.
+        G_known : numpy.ndarray
+            ``(K,)`` float, the same without the terms in ``EPISTEMIC``.
+        """
         g = np.zeros(ctx.num_candidates)
         g_known = np.zeros(ctx.num_candidates)
         for term, w in self.terms:
@@ -178,19 +324,59 @@ class Objective:
         return g, g_known
 
     def breakdown(self, ctx) -> dict[str, np.ndarray]:
-        """Weighted contribution of every term to ``G`` (same sign as ``G``)."""
+        """Weighted contribution of every term to ``G`` (same sign as ``G``).
+
+        Parameters
+        ----------
+        ctx : DenseStep or LocalStep
+            Step context of ``K`` candidates.
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            Term name -> ``(K,)`` float ``-w * term(ctx)``.
+        """
         return {getattr(t, "__name__", repr(t)): -w * t(ctx) for t, w in self.terms}
 
     @property
     def names(self) -> tuple[str, ...]:
+        """Names of the terms, in order."""
         return tuple(getattr(t, "__name__", repr(t)) for t, _ in self.terms)
 
     def uses(self, term: Term) -> bool:
+        """Whether ``term`` is among the terms with a nonzero weight.
+
+        Parameters
+        ----------
+        term : callable
+            An EFE term function.
+
+        Returns
+        -------
+        bool
+        """
         return any(t is term and w != 0.0 for t, w in self.terms)
 
 
 def objective(terms: Sequence[tuple[Term | str, float]] | dict) -> Objective:
-    """Build an objective from ``[(term, weight), ...]`` (terms as functions or names)."""
+    """Build an objective from ``[(term, weight), ...]`` (terms as functions or names), Optax-``chain`` style.
+
+    Parameters
+    ----------
+    terms : sequence of (callable or str, float) or dict
+        Term functions or names from ``ALL_TERMS`` with their weights.
+
+    Returns
+    -------
+    Objective
+
+    Raises
+    ------
+    KeyError
+        For an unknown term name.
+    TypeError
+        For a term that is not callable.
+    """
     items = terms.items() if isinstance(terms, dict) else terms
     out = []
     for t, w in items:
@@ -205,7 +391,19 @@ def objective(terms: Sequence[tuple[Term | str, float]] | dict) -> Objective:
 
 
 def exploration(collision_weight: float = 1.0, epistemic_weight: float = 1.0) -> Objective:
-    """Exploration mode: information gain on states and parameters, plus collision."""
+    """Exploration mode: information gain on states and parameters, plus collision.
+
+    Parameters
+    ----------
+    collision_weight : float, optional
+        Weight of :func:`collision`, default 1.
+    epistemic_weight : float, optional
+        Weight of :func:`state_info_gain` and of :func:`param_info_gain`, default 1.
+
+    Returns
+    -------
+    Objective
+    """
     return objective(
         [
             (state_info_gain, epistemic_weight),
@@ -234,8 +432,21 @@ def sensed_exploration(
 def goal(
     goal_weight: float = 10.0, inductive_weight: float = 1.0, collision_weight: float = 1.0
 ) -> Objective:
-    """Goal mode: observation, position and state preferences (weight 10), the inductive term
-    and collision."""
+    """Goal mode: observation, position and state preferences, the inductive term and collision.
+
+    Parameters
+    ----------
+    goal_weight : float, optional
+        Weight of the three preference terms, default 10 (Table 6 of the AIMAPP paper).
+    inductive_weight : float, optional
+        Weight of the inductive term (Eq. 9), default 1.
+    collision_weight : float, optional
+        Weight of :func:`collision`, default 1.
+
+    Returns
+    -------
+    Objective
+    """
     return objective(
         [
             (observation_preference, goal_weight),
@@ -248,7 +459,21 @@ def goal(
 
 
 def full(goal_weight: float = 10.0, inductive_weight: float = 1.0) -> Objective:
-    """All six terms of Eq. 6 plus the inductive term."""
+    """All six terms of Eq. (6) of the AIMAPP paper plus the inductive term (Eq. 9).
+
+    Information gains and collision have weight 1.
+
+    Parameters
+    ----------
+    goal_weight : float, optional
+        Weight of the three preference terms, default 10.
+    inductive_weight : float, optional
+        Weight of the inductive term, default 1.
+
+    Returns
+    -------
+    Objective
+    """
     return objective(
         [
             (state_info_gain, 1.0),

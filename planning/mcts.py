@@ -40,6 +40,35 @@ from .policies import enumerate_policies, softmax
 
 @dataclass(frozen=True)
 class MCTSConfig:
+    """Settings of the MCTS over expected free energy (Appendix A.3 of the AIMAPP paper).
+
+    Attributes
+    ----------
+    depth : int
+        Steps per simulation, default 10 (Table 6 of the AIMAPP paper).
+    simulations : int
+        Simulations per decision, default 30 (Table 6).
+    c : float
+        UCB exploration constant (values are min-max normalised per node), default 1.
+    gamma : float
+        Precision of the decision softmax (Eq. 4), default 16.
+    sample : bool
+        Sample the decision instead of taking the argmax, default False.
+    prune_obstacles : bool
+        Do not expand root moves flagged by the obstacle signal, default True.
+    move_threshold : float
+        A move is allowed when the probability of leaving the state exceeds this, default 0.
+    share : str
+        Key of the visit statistics: ``"state_depth"`` (default) or ``"state"``.
+    backup : str
+        Edge value: ``"min"`` (best cumulative EFE seen below it, default) or ``"mean"`` (UCT).
+    support_tol : float
+        Root belief entries below ``support_tol * max`` are dropped (local path), default 1e-9.
+    count_information_once : bool
+        Count epistemic value once per imagined path (revisits gain nothing), default False.
+    discount : float
+        Discount of later steps' EFE, default 1 (the plain sum of Eq. 5).
+    """
     depth: int = 10
     simulations: int = 30
     c: float = 1.0  # UCB exploration constant (values are min-max normalised per node)
@@ -90,9 +119,32 @@ class Node:
 
 
 def ucb_select(n: np.ndarray, w: np.ndarray, g: np.ndarray, N: int, c: float, tie=None) -> int:
-    """UCB over EFE. Untried children first (lowest immediate EFE ``g``); then the child
-    maximising the normalised value ``(Q_max - Q) / (Q_max - Q_min)`` plus
-    ``c sqrt(ln N / n)``, where ``Q = w / n`` is the mean cumulative EFE (lower is better)."""
+    """UCB over EFE: which child of a node to descend into.
+
+    Untried children first (lowest immediate EFE ``g``); then the child maximising the normalised
+    value ``(Q_max - Q) / (Q_max - Q_min)`` plus ``c sqrt(ln N / n)``, where ``Q = w / n`` is the mean
+    cumulative EFE (lower is better).
+
+    Parameters
+    ----------
+    n : numpy.ndarray
+        ``(K,)`` float visit count per child.
+    w : numpy.ndarray
+        ``(K,)`` float summed cumulative EFE per child.
+    g : numpy.ndarray
+        ``(K,)`` float immediate EFE per child.
+    N : int
+        Visits of the node.
+    c : float
+        Exploration constant.
+    tie : numpy.ndarray or float, optional
+        Tiny per-child tie-breaking offsets (subtracted from the score).
+
+    Returns
+    -------
+    int
+        Index of the chosen child.
+    """
     tie = 0.0 if tie is None else tie
     untried = n == 0
     if untried.any():
@@ -106,6 +158,25 @@ def ucb_select(n: np.ndarray, w: np.ndarray, g: np.ndarray, N: int, c: float, ti
 
 @dataclass
 class Decision:
+    """The outcome of one MCTS decision.
+
+    Attributes
+    ----------
+    action : int or tuple of int
+        Control (or one control per factor) to execute.
+    actions : numpy.ndarray
+        Root candidate controls.
+    probs : numpy.ndarray
+        ``(K,)`` float decision distribution over the root candidates (softmax of ``-gamma Q``).
+    Q : numpy.ndarray
+        ``(K,)`` float backed-up cumulative EFE per root candidate (nan if never visited).
+    visits : numpy.ndarray
+        ``(K,)`` float visits per root candidate.
+    G_first : numpy.ndarray
+        ``(K,)`` float one-step EFE per root candidate.
+    info : dict
+        ``"nodes"`` (tree size) and ``"expansions"`` (local expander's count, else None).
+    """
     action: int | tuple  # control (or tuple of controls per factor) to execute
     actions: np.ndarray  # root candidate controls
     probs: np.ndarray  # decision distribution over root candidates
@@ -281,8 +352,31 @@ def mcts(
     config: MCTSConfig | None = None,
     rng: np.random.Generator | int | None = None,
 ) -> Decision:
-    """MCTS decision from belief ``qs`` (list per factor). With a local preparation (one
-    sparse factor) the tree works on states; otherwise on full beliefs."""
+    """MCTS decision from a belief: a tree over states (one sparse factor) or over full beliefs.
+
+    Parameters
+    ----------
+    prep : Prepared
+        Derived arrays of the decision; a local preparation selects the state tree.
+    qs : list of numpy.ndarray
+        Current belief per factor, ``(n_f,)`` float.
+    objective : Objective
+        Per-step EFE.
+    obstacles : array_like, optional
+        Per control, True (or a probability) where an obstacle blocks that direction.
+    config : MCTSConfig, optional
+        Search settings; default ``MCTSConfig()``.
+    rng : numpy.random.Generator or int or None, optional
+        Random generator or seed (tie-breaking and sampling); the search is deterministic given it.
+
+    Returns
+    -------
+    Decision
+
+    Notes
+    -----
+    Appendix A.3 of the AIMAPP paper; the decision is Eq. (4) over the root children's values.
+    """
     cfg = config or MCTSConfig()
     rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
     if prep.local:

@@ -18,9 +18,22 @@ from .threads import limited
 def enumerate_policies(
     num_controls: Sequence[int], length: int = 1, control_factors: Sequence[int] | None = None
 ) -> np.ndarray:
-    """All policies of ``length`` steps, shape ``(P, length, F)`` (pymdp order: the last factor
-    of the last step varies fastest). Factors not in ``control_factors`` (default: those with
-    more than one control) keep control 0."""
+    """All policies of ``length`` steps (pymdp order: the last factor of the last step varies fastest).
+
+    Parameters
+    ----------
+    num_controls : sequence of int
+        Controls per factor.
+    length : int, optional
+        Steps per policy, default 1.
+    control_factors : sequence of int, optional
+        Factors whose controls vary; default those with more than one control. Others keep control 0.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(P, length, F)`` int controls.
+    """
     F = len(num_controls)
     if control_factors is None:
         control_factors = [f for f, n in enumerate(num_controls) if n > 1]
@@ -46,9 +59,41 @@ def evaluate_policies(
     obstacles=None,
     per_step: bool = False,
 ) -> np.ndarray:
-    """Expected free energy ``G(pi) = sum_tau G(pi, tau)`` of every policy (Eq. 5), rolling
-    the factor beliefs ``qs`` forward under each policy; ``per_step`` also returns ``(P, T)``.
-    The obstacle signal applies to the first step."""
+    """Expected free energy ``G(pi) = sum_tau G(pi, tau)`` of every policy, rolling beliefs forward.
+
+    The obstacle signal applies to the first step only.
+
+    Parameters
+    ----------
+    arrays : Model or PlanningArrays or Prepared
+        The model (a :class:`Prepared` must be dense, ``local=False``).
+    qs : sequence of numpy.ndarray
+        Current belief per factor, ``(n_f,)`` float (or capacity length; trimmed to live states).
+    policies : numpy.ndarray
+        ``(P, T, F)`` int controls.
+    objective : Objective
+        Per-step EFE.
+    obstacles : array_like, optional
+        Per control of the control factor, bool or probability of an obstacle.
+    per_step : bool, optional
+        Also return the per-step values, default False.
+
+    Returns
+    -------
+    G : numpy.ndarray
+        ``(P,)`` float expected free energy (lower is better).
+    steps : numpy.ndarray
+        ``(P, T)`` float per-step values; only when ``per_step``.
+
+    Raises
+    ------
+    ValueError
+        If given a local (sparse-path) preparation.
+
+    Notes
+    -----
+    Eq. (5) of the AIMAPP paper.
+    """
     with limited():
         return _evaluate(arrays, qs, policies, objective, obstacles, per_step)
 
@@ -72,7 +117,26 @@ def _evaluate(arrays, qs, policies, objective, obstacles, per_step):
 
 
 def policy_posterior(G: np.ndarray, gamma: float = 16.0, log_E: np.ndarray | None = None) -> np.ndarray:
-    """``q(pi) = softmax(-gamma G + ln E)`` (Eq. 4)."""
+    """Policy posterior ``q(pi) = softmax(-gamma G + ln E)``.
+
+    Parameters
+    ----------
+    G : numpy.ndarray
+        ``(P,)`` float expected free energy per policy.
+    gamma : float, optional
+        Precision, default 16.
+    log_E : numpy.ndarray, optional
+        ``(P,)`` float log prior over policies (habits).
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(P,)`` float, sums to 1.
+
+    Notes
+    -----
+    Eq. (4) of the AIMAPP paper.
+    """
     x = -gamma * np.asarray(G, dtype=float)
     if log_E is not None:
         x = x + log_E
@@ -80,7 +144,20 @@ def policy_posterior(G: np.ndarray, gamma: float = 16.0, log_E: np.ndarray | Non
 
 
 def select(q: np.ndarray, rng: np.random.Generator | None = None) -> int:
-    """Argmax of ``q`` (first on ties) or, with ``rng``, a sample from it."""
+    """Argmax of ``q`` (first on ties) or, with ``rng``, a sample from it.
+
+    Parameters
+    ----------
+    q : numpy.ndarray
+        ``(P,)`` float distribution.
+    rng : numpy.random.Generator, optional
+        Random generator; sample when given.
+
+    Returns
+    -------
+    int
+        The chosen index.
+    """
     if rng is None:
         return int(np.argmax(q))
     return int(rng.choice(len(q), p=q))
@@ -102,8 +179,36 @@ def infer_policies(
     obstacles=None,
     rng: np.random.Generator | None = None,
 ):
-    """Enumerate, evaluate and pick: returns ``(first_action (F,), q_pi, G, policies)``.
-    ``arrays`` is a compiled ``Model``, :class:`PlanningArrays` or a :class:`Prepared`."""
+    """Enumerate, evaluate and pick a policy; returns its first action.
+
+    Parameters
+    ----------
+    arrays : Model or PlanningArrays or Prepared
+        The model.
+    qs : sequence of numpy.ndarray
+        Current belief per factor.
+    objective : Objective
+        Per-step EFE.
+    length : int, optional
+        Policy length, default 1.
+    gamma : float, optional
+        Policy precision, default 16.
+    obstacles : array_like, optional
+        Per-control obstacle signal (first step).
+    rng : numpy.random.Generator, optional
+        Sample the policy instead of taking the argmax.
+
+    Returns
+    -------
+    action : numpy.ndarray
+        ``(F,)`` int first-step controls of the chosen policy.
+    q_pi : numpy.ndarray
+        ``(P,)`` float policy posterior.
+    G : numpy.ndarray
+        ``(P,)`` float expected free energies.
+    policies : numpy.ndarray
+        ``(P, length, F)`` int.
+    """
     arrays = arrays if isinstance(arrays, Prepared) else as_arrays(arrays)
     a = arrays.arrays if isinstance(arrays, Prepared) else arrays
     policies = enumerate_policies(a.num_controls, length)

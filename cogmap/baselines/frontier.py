@@ -45,6 +45,37 @@ from .policy import BaselinePolicy
 
 @dataclass(frozen=True)
 class FrontierConfig:
+    """Settings of :class:`FrontierExplorer` (explore_lite's defaults where it has them).
+
+    Attributes
+    ----------
+    resolution : float
+        Map cell side, metres (default 0.05).
+    plan_factor : int
+        Planning grid cell = ``resolution * plan_factor`` (default 2).
+    step_length : float
+        Longest move per decision, metres.
+    robot_radius : float
+        Metres.
+    inflation_margin : float
+        Planned paths keep ``robot_radius + inflation_margin`` metres from obstacles.
+    min_frontier_size : float
+        Clusters shorter than this (metres) are dropped.
+    potential_scale, gain_scale : float
+        explore_lite's cost ``potential_scale * distance - gain_scale * size`` (defaults 3 and 1).
+    progress_timeout : int
+        Steps without getting closer before a goal is blacklisted.
+    max_failures : int
+        Consecutive failed moves before a goal is blacklisted.
+    blacklist_radius : float
+        Goals within this distance (metres) of a blacklisted one are skipped.
+    goal_tolerance : float
+        Distance (metres) at which the robot counts as on its goal.
+    map_size : float
+        Side (metres) of the square map centred on the start odometry.
+    lidar_range : float
+        Maximum LiDAR range, metres; shorter beams mark their end point occupied.
+    """
     resolution: float = 0.05
     plan_factor: int = 2  # planning grid = resolution * plan_factor
     step_length: float = 1.0
@@ -62,7 +93,17 @@ class FrontierConfig:
 
 
 class OdomMap:
-    """Occupancy grid in the odometry frame: ``seen`` (observed) and ``occ`` (occupied)."""
+    """Occupancy grid in the odometry frame: ``seen`` (observed) and ``occ`` (occupied).
+
+    Parameters
+    ----------
+    center_xy : array_like
+        ``(x, y)`` centre of the square map, metres, odometry frame.
+    size : float
+        Side of the map, metres.
+    resolution : float
+        Cell side, metres.
+    """
 
     def __init__(self, center_xy, size: float, resolution: float):
         n = int(np.ceil(size / resolution))
@@ -74,10 +115,33 @@ class OdomMap:
         self.bbox = None  # (r0, r1, c0, c1) of seen cells, inclusive-exclusive
 
     def to_cell(self, xy) -> np.ndarray:
-        """(..., 2) odometry-frame points -> (row, col), the grid convention of the envs."""
+        """Odometry-frame points to cells (the grid convention of the envs).
+
+        Parameters
+        ----------
+        xy : array_like
+            ``(..., 2)`` float, metres.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(..., 2)`` int ``(row, col)``.
+        """
         return self._frame.world_to_cell(xy)
 
     def to_xy(self, rc) -> np.ndarray:
+        """Cells to the odometry-frame coordinates of their centres.
+
+        Parameters
+        ----------
+        rc : array_like
+            ``(..., 2)`` ``(row, col)``.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(..., 2)`` float, metres.
+        """
         return self._frame.cell_to_world(rc)
 
     def _grow_bbox(self, r0, r1, c0, c1) -> None:
@@ -88,7 +152,22 @@ class OdomMap:
             self.bbox = (min(b[0], r0), max(b[1], r1), min(b[2], c0), max(b[3], c1))
 
     def integrate(self, pose, ranges, angles, max_range: float) -> None:
-        """Add one scan taken at odometry ``pose`` (x, y, yaw); beams in the robot frame."""
+        """Add one scan taken at odometry ``pose``.
+
+        The polygon of beam end points becomes seen; end points of beams shorter than ``max_range``
+        become occupied; cells deep inside the polygon clear stale obstacle marks.
+
+        Parameters
+        ----------
+        pose : array_like
+            ``(3,)`` odometry pose ``(x, y, yaw)``, metres and radians.
+        ranges : array_like
+            ``(B,)`` float beam ranges, metres.
+        angles : array_like
+            ``(B,)`` float beam angles in the robot frame, radians.
+        max_range : float
+            LiDAR maximum range, metres.
+        """
         import cv2
 
         a = pose[2] + np.asarray(angles)
@@ -120,6 +199,15 @@ class OdomMap:
         self._grow_bbox(int(r0), int(r1), int(c0), int(c1))
 
     def mark_occupied(self, xy, radius: float) -> None:
+        """Mark a disc occupied (and seen), e.g. a bumper hit the LiDAR missed.
+
+        Parameters
+        ----------
+        xy : array_like
+            ``(x, y)`` centre, metres, odometry frame.
+        radius : float
+            Metres.
+        """
         rc = self.to_cell(xy)
         k = int(np.ceil(radius / self.resolution))
         rr, cc = np.mgrid[-k:k + 1, -k:k + 1]
@@ -142,7 +230,15 @@ class Frontier:
 
 
 class FrontierExplorer(BaselinePolicy):
-    """Greedy frontier exploration on the robot's own odometry-frame map."""
+    """Greedy frontier exploration (Yamauchi 1997, explore_lite goal cost) on the robot's odometry-frame map.
+
+    Uses only LiDAR and odometry; see the module docstring for the map, goal and blacklisting rules.
+
+    Parameters
+    ----------
+    config : FrontierConfig, optional
+        Settings; default ``FrontierConfig()``.
+    """
 
     mode = "frontier"
 
@@ -161,6 +257,19 @@ class FrontierExplorer(BaselinePolicy):
 
     # ------------------------------------------------------------------ map
     def observe(self, odom, ranges, angles, moved: bool | None) -> None:
+        """Update the map from one scan; a failed move adds a bumper mark ahead of the robot.
+
+        Parameters
+        ----------
+        odom : numpy.ndarray or None
+            ``(3,)`` odometry pose; nothing happens when None (dropped).
+        ranges : numpy.ndarray or None
+            Beam ranges, metres (None: LiDAR dropped).
+        angles : numpy.ndarray
+            Beam angles in the robot frame, radians.
+        moved : bool or None
+            Outcome of the last move.
+        """
         cfg = self.cfg
         if odom is None:
             return
@@ -186,7 +295,18 @@ class FrontierExplorer(BaselinePolicy):
         return r0, r1, c0, c1
 
     def detect(self, odom) -> list[Frontier]:
-        """Frontier clusters with their goal, path length and explore_lite cost."""
+        """Frontier clusters with their goal, path length and explore_lite cost.
+
+        Parameters
+        ----------
+        odom : array_like
+            ``(>=2,)`` robot position in the odometry frame, metres.
+
+        Returns
+        -------
+        list of Frontier
+            Clusters of at least ``min_frontier_size``; ``goal`` is None for an unreachable one.
+        """
         cfg, m = self.cfg, self.map
         res, f = cfg.resolution, cfg.plan_factor
         r0, r1, c0, c1 = self._roi(int(1.0 / res))
@@ -241,7 +361,19 @@ class FrontierExplorer(BaselinePolicy):
 
     # ------------------------------------------------------------------ decision
     def decide(self, odom) -> np.ndarray | None:
-        """Next waypoint (odometry frame), or None when exploration is finished."""
+        """Next waypoint toward the cheapest non-blacklisted frontier, or None when exploration is finished.
+
+        Parameters
+        ----------
+        odom : numpy.ndarray or None
+            ``(3,)`` odometry pose.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(2,)`` float waypoint in the odometry frame, metres (the current position while no map
+            exists yet); None when there is no odometry or no frontier is left.
+        """
         cfg = self.cfg
         if odom is None or self.map is None or self.map.bbox is None:
             return None if odom is None else np.asarray(odom[:2], float)
@@ -292,7 +424,20 @@ class FrontierExplorer(BaselinePolicy):
 
     # ------------------------------------------------------------------ policy interface
     def plan(self, sim, moved: bool | None):
-        """Sense (LiDAR + odometry only), update the map, return (waypoint, frame) or None."""
+        """Sense (LiDAR and odometry only), update the map, and choose the next waypoint.
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator (read: odometry and LiDAR only).
+        moved : bool or None
+            Whether the last move succeeded (False: a collision stopped it); None before the first.
+
+        Returns
+        -------
+        tuple or None
+            ``(waypoint (2,), "odom")``, or None when exploration is finished.
+        """
         odom = sim.odometry()
         self.observe(odom, sim.lidar(), sim.lidar_angles(), moved)
         wp = self.decide(odom)
@@ -301,5 +446,17 @@ class FrontierExplorer(BaselinePolicy):
         return wp, "odom"
 
     def believed_pose(self, sim) -> np.ndarray:
+        """The robot's believed position: its odometry.
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float, metres (nan while odometry is dropped).
+        """
         odom = sim.odometry()
         return np.full(2, np.nan) if odom is None else odom[:2]

@@ -45,6 +45,23 @@ from .frontier import FrontierConfig, FrontierExplorer
 
 @dataclass(frozen=True)
 class FrontierPaperConfig(FrontierConfig):
+    """Settings of :class:`FrontierPaperExplorer`: :class:`FrontierConfig` with explore_lite / Nav2 values.
+
+    Attributes
+    ----------
+    min_frontier_size : float
+        explore_lite's default, 0.75 m.
+    progress_timeout : int
+        Decisions without the frontier getting closer before blacklisting (explore_lite's 30 s), 8.
+    max_failures : int
+        Failed attempts (failed moves, no plan) before a goal is blacklisted, 3.
+    blacklist_radius : float
+        Metres; explore_lite's 5 cells of 0.05 m.
+    goal_tolerance : float
+        Nav2's ``xy_goal_tolerance``, metres.
+    planner_tolerance : float
+        NavFn's tolerance around a blocked goal, metres.
+    """
     min_frontier_size: float = 0.75  # explore_lite default
     progress_timeout: int = 8  # decisions without the frontier getting closer (explore_lite 30 s)
     max_failures: int = 3  # failed attempts (failed moves, no plan) before a goal is blacklisted
@@ -54,7 +71,13 @@ class FrontierPaperConfig(FrontierConfig):
 
 
 class FrontierPaperExplorer(FrontierExplorer):
-    """explore_lite-like frontier exploration: goals at frontier centroids, failures count."""
+    """explore_lite-like frontier exploration: goals at frontier centroids, failures count.
+
+    Parameters
+    ----------
+    config : FrontierPaperConfig, optional
+        Settings; default ``FrontierPaperConfig()``.
+    """
 
     mode = "frontier_paper"
 
@@ -67,7 +90,19 @@ class FrontierPaperExplorer(FrontierExplorer):
         self.pushes = 0  # decisions driving straight at a goal the plan could not reach
 
     def observe(self, odom, ranges, angles, moved: bool | None) -> None:
-        """As the parent, but failures toward a goal accumulate (a success does not reset them)."""
+        """As the parent, but failures toward a goal accumulate (a successful move does not reset them).
+
+        Parameters
+        ----------
+        odom : numpy.ndarray or None
+            ``(3,)`` odometry pose.
+        ranges : numpy.ndarray or None
+            Beam ranges, metres.
+        angles : numpy.ndarray
+            Beam angles in the robot frame, radians.
+        moved : bool or None
+            Outcome of the last move.
+        """
         before = self.failures
         super().observe(odom, ranges, angles, moved)
         if moved is False:
@@ -86,9 +121,21 @@ class FrontierPaperExplorer(FrontierExplorer):
         self._reset_goal(None)
 
     def plan_target(self, goal) -> tuple[np.ndarray, float] | None:
-        """Where Nav2 would plan to: the goal if its planning cell is reachable, else the reachable
-        planning cell nearest the goal within ``planner_tolerance``; with its path length (m).
-        None when no plan exists. Uses the search from the last :meth:`detect`."""
+        """Where Nav2 would plan to, using the search from the last :meth:`detect`.
+
+        The goal if its planning cell is reachable, else the reachable planning cell nearest the goal
+        within ``planner_tolerance``.
+
+        Parameters
+        ----------
+        goal : array_like
+            ``(2,)`` goal in the odometry frame, metres.
+
+        Returns
+        -------
+        tuple or None
+            ``(target (2,) metres, path length in metres)``, or None when no plan exists.
+        """
         cfg, m = self.cfg, self.map
         pred, blocked, (r0, c0) = self._plan
         dist = self._dist
@@ -112,8 +159,19 @@ class FrontierPaperExplorer(FrontierExplorer):
         return m.to_xy(cell), float(dist[rr[j], cc[j]] * res * f)
 
     def decide(self, odom) -> np.ndarray | None:
-        """Next waypoint (odometry frame; the robot's own position = wait in place), or None when
-        exploration is finished."""
+        """Next waypoint toward the cheapest non-blacklisted frontier centroid.
+
+        Parameters
+        ----------
+        odom : numpy.ndarray or None
+            ``(3,)`` odometry pose.
+
+        Returns
+        -------
+        numpy.ndarray or None
+            ``(2,)`` float waypoint in the odometry frame, metres (the robot's own position means wait in
+            place); None when there is no odometry or exploration is finished.
+        """
         cfg = self.cfg
         if odom is None or self.map is None or self.map.bbox is None:
             return None if odom is None else np.asarray(odom[:2], float)

@@ -25,6 +25,29 @@ from .policy import BaselinePolicy
 
 @dataclass(frozen=True)
 class OracleConfig:
+    """Settings of :class:`OracleTour`.
+
+    Attributes
+    ----------
+    step_length : float
+        Longest move per decision, metres.
+    robot_radius : float
+        Metres.
+    inflation_margin : float
+        Paths keep ``robot_radius + inflation_margin`` metres from obstacles.
+    plan_factor : int
+        Planning grid cell = grid resolution * ``plan_factor``.
+    viewpoint_spacing : float
+        Spacing of the viewpoint lattice, metres.
+    rays : int
+        Rays cast per viewpoint.
+    lidar_range : float
+        Metres.
+    min_gain : float
+        Smallest unseen free area (square metres) worth a viewpoint.
+    detour_offset : float
+        Metres added to the path length in the score ``gain / (path + offset)``.
+    """
     step_length: float = 1.0
     robot_radius: float = 0.22
     inflation_margin: float = 0.08
@@ -54,6 +77,16 @@ def visible_mask(occupied: np.ndarray, origin, resolution: float, xy, rays: int,
 
 
 class OracleTour(BaselinePolicy):
+    """Oracle coverage tour on the known map (stands in for the paper's human teleoperation).
+
+    Knows the true grid and true pose; goes to the viewpoint with the most still-unseen free area per
+    metre of path, one world-frame move per decision (see the module docstring).
+
+    Parameters
+    ----------
+    config : OracleConfig, optional
+        Settings; default ``OracleConfig()``.
+    """
     mode = "oracle"
 
     def __init__(self, config: OracleConfig | None = None):
@@ -108,7 +141,20 @@ class OracleTour(BaselinePolicy):
         return True
 
     def plan(self, sim, moved: bool | None):
-        """Uses the true pose, the true grid and the coverage so far (an informed operator)."""
+        """Next waypoint along the tour, using the true pose, the true grid and the coverage so far.
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+        moved : bool or None
+            Whether the last move succeeded; a failed move marks the current viewpoint as visited.
+
+        Returns
+        -------
+        tuple or None
+            ``(waypoint (2,) metres, "world")``, or None when nothing worth a detour remains.
+        """
         cfg = self.cfg
         if not self.ready:
             self._prepare(sim)
@@ -136,4 +182,16 @@ class OracleTour(BaselinePolicy):
         return next_waypoint(self.path, pos, cfg.step_length, visible), "world"
 
     def believed_pose(self, sim) -> np.ndarray:
+        """The true position (the oracle knows it).
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float, metres, world frame.
+        """
         return sim.true_pose()[:2]

@@ -27,18 +27,71 @@ class BaselinePolicy:
 
     @property
     def label(self) -> str:
+        """Progress-bar description: the baseline's ``mode``."""
         return self.mode
 
     def sense(self, sim, moved: bool | None) -> SimView:
+        """What the baseline senses: the simulator itself with the outcome of the last move.
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator (each baseline reads only the sensors it is allowed).
+        moved : bool or None
+            Whether the last move succeeded; None before the first.
+
+        Returns
+        -------
+        SimView
+        """
         return SimView(sim, moved)
 
     def plan(self, sim, moved: bool | None):  # pragma: no cover - abstract
+        """Choose the next waypoint (implemented by each baseline).
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+        moved : bool or None
+            Whether the last move succeeded; None before the first.
+
+        Returns
+        -------
+        tuple or None
+            ``(waypoint (2,) metres, frame)`` with frame ``"odom"`` or ``"world"``, or None when the
+            baseline has finished.
+        """
         raise NotImplementedError
 
     def believed_pose(self, sim) -> np.ndarray:  # pragma: no cover - abstract
+        """Where the baseline believes the robot is (implemented by each baseline).
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float ``(x, y)``, metres.
+        """
         raise NotImplementedError
 
     def step(self, sensed: SimView) -> Command:
+        """Plan and wrap the result as a harness command with the trajectory row.
+
+        Parameters
+        ----------
+        sensed : SimView
+            What :meth:`sense` returned.
+
+        Returns
+        -------
+        Command
+            ``done`` when :meth:`plan` returned None (mode ``"done"`` in the row).
+        """
         cmd = self.plan(sensed.sim, sensed.moved)
         belief = self.believed_pose(sensed.sim)
         row = dict(belief_x=belief[0], belief_y=belief[1], state=-1, action=-1,

@@ -12,6 +12,15 @@ from .policy import BaselinePolicy
 
 
 class RandomWalk(BaselinePolicy):
+    """Random walk: a uniformly random heading each decision, one step length in the odometry frame.
+
+    Parameters
+    ----------
+    step_length : float, optional
+        Metres per move, default 1.
+    seed : int, optional
+        Seed of the heading draws, default 0.
+    """
     mode = "random"
 
     def __init__(self, step_length: float = 1.0, seed: int = 0):
@@ -19,6 +28,21 @@ class RandomWalk(BaselinePolicy):
         self.rng = np.random.default_rng(seed)
 
     def plan(self, sim, moved: bool | None):
+        """A waypoint one step length away along a random heading (relative to the odometry pose).
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator (read: odometry only).
+        moved : bool or None
+            Outcome of the last move (unused).
+
+        Returns
+        -------
+        tuple
+            ``(waypoint (2,) metres, "odom")``; while odometry is dropped, the true position with
+            ``"world"`` (the robot stays in place).
+        """
         odom = sim.odometry()
         h = float(self.rng.uniform(0.0, 2 * np.pi))
         if odom is None:  # no odometry: move blind relative to the true pose cannot be commanded
@@ -26,5 +50,17 @@ class RandomWalk(BaselinePolicy):
         return odom[:2] + self.step_length * np.array([np.cos(h), np.sin(h)]), "odom"
 
     def believed_pose(self, sim) -> np.ndarray:
+        """The odometry position.
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float, metres (nan while odometry is dropped).
+        """
         odom = sim.odometry()
         return np.full(2, np.nan) if odom is None else odom[:2]

@@ -16,6 +16,25 @@ __all__ = ["coverage_tracker", "run_policy"]
 
 def run_policy(sim, policy, steps: int, progress: bool = False, stop_coverage: float | None = None,
                episode: Episode | None = None) -> Episode:
-    """Run ``policy`` for at most ``steps`` decisions (fewer if it finishes or reaches
-    ``stop_coverage``)."""
+    """Run a baseline for at most ``steps`` decisions (fewer if it finishes or reaches ``stop_coverage``).
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+    policy : Policy
+        The baseline (any :class:`cogmap.harness.Policy`).
+    steps : int
+        Largest number of decisions.
+    progress : bool, optional
+        Show a progress bar, default False.
+    stop_coverage : float, optional
+        Coverage in [0, 1] at which to stop.
+    episode : Episode, optional
+        An earlier episode to continue.
+
+    Returns
+    -------
+    Episode
+    """
     return run_episode(sim, policy, steps, progress=progress, episode=episode, stop_coverage=stop_coverage)

@@ -38,6 +38,20 @@ class VoxelMap:
     golden-ratio fraction of that spacing, so a short memory of recent scans (default 12, the scans
     of about 2-3 planning steps with the in-flight ones) fills the gaps while keeping the voxel count,
     and so the planning time, bounded. Voxels seen in several scans count once.
+
+    Parameters
+    ----------
+    voxel : float, optional
+        Voxel side, metres.
+    min_points : int, optional
+        Hits a voxel needs to count as an obstacle.
+    memory : int, optional
+        Number of recent scans kept, at least 1; default 12.
+
+    Raises
+    ------
+    ValueError
+        If ``memory < 1``.
     """
 
     def __init__(self, voxel: float = VOXEL_SIZE, min_points: int = MIN_POINTS, memory: int = 12):
@@ -48,17 +62,39 @@ class VoxelMap:
         self._points = None
 
     def add(self, hits) -> None:
+        """Add one scan's hit points (the oldest scan is forgotten when ``memory`` is full).
+
+        Parameters
+        ----------
+        hits : array_like
+            ``(N, 3)`` float hit points, metres, world frame.
+        """
         self.scans.append(np.asarray(hits, float).reshape(-1, 3))
         self._points = None
 
     @property
     def points(self) -> np.ndarray:
+        """``(V, 3)`` float obstacle voxels of the remembered scans (computed on first access)."""
         if self._points is None:
             pts = np.vstack(list(self.scans)) if self.scans else np.zeros((0, 3))
             self._points = voxelise(pts, self.voxel, self.min_points)
         return self._points
 
     def near(self, position, radius: float = SENSE_RADIUS) -> np.ndarray:
+        """Voxels within ``radius`` of ``position``.
+
+        Parameters
+        ----------
+        position : array_like
+            ``(3,)`` metres.
+        radius : float, optional
+            Metres; default the LiDAR range (20 m).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(k, 3)`` float voxels.
+        """
         P = self.points
         if len(P) == 0:
             return P
@@ -67,6 +103,25 @@ class VoxelMap:
 
 @dataclass(frozen=True)
 class DroneAgentConfig:
+    """Settings of :class:`DroneAgent`.
+
+    Attributes
+    ----------
+    planner : DronePlannerConfig
+        Waypoint generation, filtering and EFE ranking settings.
+    persistent_beliefs : bool
+        False (default): per-call re-initialisation of the kernel beliefs, as published.
+    scan_memory : int
+        LiDAR scans whose voxels describe the surroundings (1: per scan), default 12.
+    replan_distance : float
+        Replan when an obstacle comes within this many metres in flight.
+    near_goal : float
+        Slow down within this distance (metres) of the target.
+    dense : float
+        ... or when the density exceeds this.
+    depth : int
+        1: the paper's one-step ranking; 2 or 3: EFE over waypoint sequences (beyond the paper).
+    """
     planner: DronePlannerConfig = field(default_factory=DronePlannerConfig)
     persistent_beliefs: bool = False  # False: per-call re-initialisation, as published
     scan_memory: int = 12  # LiDAR scans whose voxels describe the surroundings (1: per-scan)
@@ -76,6 +131,12 @@ class DroneAgentConfig:
     depth: int = 1  # 1: the paper's one-step ranking; 2 or 3: EFE over waypoint sequences (beyond the paper)
 
     def to_dict(self) -> dict:
+        """The settings as a nested dict (for run records).
+
+        Returns
+        -------
+        dict
+        """
         from dataclasses import asdict
 
         return asdict(self)
@@ -91,8 +152,20 @@ class Decision:
 
 
 class DroneAgent:
-    """See the module docstring. ``observe(scan)`` feeds LiDAR sweeps (also those taken in flight);
-    ``decide(position, target)`` returns a :class:`Decision`."""
+    """The drone's stateful shell: voxel memory, kernel beliefs, RNG; the maths lives in the libraries.
+
+    ``observe(scan)`` feeds LiDAR sweeps (also those taken in flight); ``decide(position, target)``
+    returns a :class:`Decision`.
+
+    Parameters
+    ----------
+    config : DroneAgentConfig, optional
+        Settings; default ``DroneAgentConfig()``.
+    seed : int, optional
+        Seed of the planner's random candidates, default 0.
+    speeds : tuple of float, optional
+        ``(cruise, slow)`` speeds in m/s, default ``(2.0, 1.5)``.
+    """
 
     replans_in_flight = True
 
@@ -105,6 +178,15 @@ class DroneAgent:
         self.reset()
 
     def reset(self, target=None, start=None) -> None:
+        """Start an episode: empty voxel memory and beliefs; remember the start-to-target distance if given.
+
+        Parameters
+        ----------
+        target : array_like, optional
+            ``(3,)`` target position, metres.
+        start : array_like, optional
+            ``(3,)`` start position, metres.
+        """
         self.voxels = VoxelMap(memory=self.config.scan_memory)
         self.beliefs = None
         self.d_start = None
@@ -112,16 +194,58 @@ class DroneAgent:
             self.d_start = float(np.linalg.norm(np.asarray(target, float) - np.asarray(start, float)))
 
     def observe(self, scan, position=None) -> None:
+        """Add a LiDAR scan to the voxel memory.
+
+        Parameters
+        ----------
+        scan : object
+            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
+        position : array_like, optional
+            Where the scan was taken (unused).
+        """
         self.voxels.add(scan.points)
 
     def sense(self, position) -> tuple[np.ndarray, float, float, float]:
-        """(nearby voxels, d_obs, rho, S) at ``position``."""
+        """What the drone perceives at ``position``.
+
+        Parameters
+        ----------
+        position : array_like
+            ``(3,)`` metres.
+
+        Returns
+        -------
+        voxels : numpy.ndarray
+            ``(k, 3)`` float voxels within the LiDAR range.
+        d_obs : float
+            Clearance to the nearest voxel, metres.
+        rho : float
+            Obstacle density.
+        S : float
+            Suitability in [0, 1] (DRONE.md formula).
+        """
         V = self.voxels.near(position)
         d_obs = clearance(position, V)
         rho = density(position, V)
         return V, d_obs, rho, float(suitability(d_obs, rho))
 
     def decide(self, position, target) -> Decision:
+        """Sense, update the kernel beliefs, plan and rank candidate waypoints; return the first action.
+
+        Slows down near the target or in dense clutter.
+
+        Parameters
+        ----------
+        position : array_like
+            ``(3,)`` current position, metres, world frame.
+        target : array_like
+            ``(3,)`` target position, metres.
+
+        Returns
+        -------
+        Decision
+            ``waypoint`` (``(3,)`` metres), ``speed`` (m/s), ``plan``, ``plan_ms`` and ``state``.
+        """
         pos = np.asarray(position, float)
         tgt = np.asarray(target, float)
         if self.d_start is None:

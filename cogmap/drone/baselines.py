@@ -16,7 +16,15 @@ class _Plan:
 
 
 class StraightLine:
-    """Fly toward the target in steps of ``step`` metres, blind to obstacles."""
+    """Fly toward the target in steps of ``step`` metres, blind to obstacles.
+
+    Parameters
+    ----------
+    step : float, optional
+        Metres per decision, default 3.
+    speeds : tuple of float, optional
+        ``(cruise, slow)`` m/s; slow within 10 m of the target.
+    """
 
     replans_in_flight = False
 
@@ -24,12 +32,44 @@ class StraightLine:
         self.step, self.speeds = step, speeds
 
     def reset(self, target=None, start=None) -> None:
+        """Nothing to reset (stateless).
+
+        Parameters
+        ----------
+        target : array_like, optional
+            ``(3,)`` target position, metres.
+        start : array_like, optional
+            ``(3,)`` start position, metres.
+        """
         pass
 
     def observe(self, scan, position=None) -> None:
+        """Ignore the scan (blind to obstacles).
+
+        Parameters
+        ----------
+        scan : object
+            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
+        position : array_like, optional
+            Where the scan was taken (unused).
+        """
         pass
 
     def decide(self, position, target) -> Decision:
+        """A waypoint ``step`` metres toward the target (the target itself when closer).
+
+        Parameters
+        ----------
+        position : array_like
+            ``(3,)`` current position, metres, world frame.
+        target : array_like
+            ``(3,)`` target position, metres.
+
+        Returns
+        -------
+        Decision
+            ``waypoint`` (``(3,)`` metres), ``speed`` (m/s), ``plan``, ``plan_ms`` and ``state``.
+        """
         pos, tgt = np.asarray(position, float), np.asarray(target, float)
         d = tgt - pos
         n = float(np.linalg.norm(d))
@@ -38,9 +78,26 @@ class StraightLine:
 
 
 class PotentialField:
-    """Attraction to the target plus repulsion from voxels within ``influence`` metres
-    (k_rep (1/d - 1/influence) / d^2 along the away direction); one step of ``step`` metres along
-    the resulting force; a floor keeps it above ``min_altitude``."""
+    """Attraction to the target plus repulsion from voxels within ``influence`` metres.
+
+    Repulsion ``k_rep (1/d - 1/influence) / d^2`` along the away direction; one step of ``step``
+    metres along the resulting force; a floor keeps it above ``min_altitude``.
+
+    Parameters
+    ----------
+    step : float, optional
+        Metres per decision, default 2.
+    influence : float, optional
+        Repulsion radius, metres, default 5.
+    k_att : float, optional
+        Attraction gain, default 1.
+    k_rep : float, optional
+        Repulsion gain, default 4.
+    min_altitude : float, optional
+        Lowest waypoint altitude, metres, default 1.
+    speeds : tuple of float, optional
+        ``(cruise, slow)`` m/s; slow within 10 m of the target.
+    """
 
     replans_in_flight = False
 
@@ -51,12 +108,44 @@ class PotentialField:
         self.voxels = VoxelMap()
 
     def reset(self, target=None, start=None) -> None:
+        """Forget the sensed voxels.
+
+        Parameters
+        ----------
+        target : array_like, optional
+            ``(3,)`` target position, metres.
+        start : array_like, optional
+            ``(3,)`` start position, metres.
+        """
         self.voxels = VoxelMap()
 
     def observe(self, scan, position=None) -> None:
+        """Add a LiDAR scan to the voxel memory.
+
+        Parameters
+        ----------
+        scan : object
+            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
+        position : array_like, optional
+            Where the scan was taken (unused).
+        """
         self.voxels.add(scan.points)
 
     def decide(self, position, target) -> Decision:
+        """One step along the summed attractive and repulsive force.
+
+        Parameters
+        ----------
+        position : array_like
+            ``(3,)`` current position, metres, world frame.
+        target : array_like
+            ``(3,)`` target position, metres.
+
+        Returns
+        -------
+        Decision
+            ``waypoint`` (``(3,)`` metres), ``speed`` (m/s), ``plan``, ``plan_ms`` and ``state``.
+        """
         pos, tgt = np.asarray(position, float), np.asarray(target, float)
         d = tgt - pos
         n = float(np.linalg.norm(d))

@@ -18,6 +18,24 @@ SUCCESS_RADIUS = 1.5
 
 @dataclass(frozen=True)
 class EpisodeLimits:
+    """Stopping rules and timing of one drone episode.
+
+    Attributes
+    ----------
+    max_steps : int
+        Decisions before a timeout, default 250.
+    max_time_s : float
+        Simulated seconds before a timeout, default 250.
+    stuck_time_s : float
+        Window (s) of the stuck test, default 15.
+    stuck_distance : float
+        The drone is stuck when it stayed within this many metres of where it was ``stuck_time_s``
+        earlier, default 1.
+    step_overhead_s : float
+        Simulated seconds of hovering added per step while the command is served, default 1.
+    success_radius : float
+        Final distance (metres) to the target that counts as success, default 1.5.
+    """
     max_steps: int = 250
     max_time_s: float = 250.0
     stuck_time_s: float = 15.0
@@ -27,9 +45,26 @@ class EpisodeLimits:
 
 
 def make_policy(method: str, seed: int = 0):
-    """The policy of a method name: ``agent`` (hierarchical AIF), ``agent_persistent`` (beliefs
-    kept across steps), ``no_filter``, ``no_epistemic``, ``agent_depth2`` / ``agent_depth3`` (EFE over
-    waypoint sequences), ``straight``, ``potential``."""
+    """The policy of a drone method name.
+
+    Parameters
+    ----------
+    method : str
+        ``"agent"`` (hierarchical AIF), ``"agent_persistent"`` (beliefs kept across steps),
+        ``"no_filter"``, ``"no_epistemic"``, ``"agent_depth2"`` / ``"agent_depth3"`` (EFE over
+        waypoint sequences), ``"straight"`` or ``"potential"``.
+    seed : int, optional
+        Seed of the agent's planner, default 0 (unused by the baselines).
+
+    Returns
+    -------
+    DroneAgent or StraightLine or PotentialField
+
+    Raises
+    ------
+    ValueError
+        For an unknown method.
+    """
     from dataclasses import replace
 
     from .agent import DroneAgent, DroneAgentConfig
@@ -66,9 +101,29 @@ def _stuck(times, positions, now: float, window: float, dist: float) -> bool:
 
 
 def fly_episode(sim, policy, target, limits: EpisodeLimits | None = None, log=None) -> dict:
-    """Fly one episode from the simulator's start to ``target``; returns the metrics dict.
+    """Fly one episode from the simulator's start to ``target``: plan, fly the first action, replan.
 
-    ``log(row)`` receives one dict per step (step, time, position, waypoint, flags)."""
+    Parameters
+    ----------
+    sim : DroneSim
+        The drone simulator (reset at the start).
+    policy : DroneAgent or StraightLine or PotentialField
+        Anything with ``reset``, ``observe``, ``decide`` and ``replans_in_flight``.
+    target : array_like
+        ``(3,)`` target position, metres.
+    limits : EpisodeLimits, optional
+        Stopping rules; default ``EpisodeLimits()``.
+    log : callable, optional
+        ``log(row)`` receives one dict per step (step, time, position, waypoint, flags).
+
+    Returns
+    -------
+    dict
+        Metrics: ``outcome`` (``"success"``, ``"stuck"``, ``"timeout"`` or ``"crashed"``) and its
+        flags, ``collisions``, ``collision_free_success``, ``replans``, ``steps``, initial and final
+        distance (m), ``time_s``, ``fallback_steps``, planning times (ms: median, p95, every call), the
+        median EFE time per candidate (us), ``target`` and ``limits``.
+    """
     lim = limits or EpisodeLimits()
     tgt = np.asarray(target, float)
     start = sim.reset()
@@ -130,8 +185,21 @@ def fly_episode(sim, policy, target, limits: EpisodeLimits | None = None, log=No
 
 
 def summarise(episodes: list[dict]) -> dict:
-    """Rates and means over episodes (replans split by success and failure; timing pooled over all
-    planning calls)."""
+    """Rates and means over episodes (replans split by success and failure; timing pooled over all planning calls).
+
+    Parameters
+    ----------
+    episodes : list of dict
+        Results of :func:`fly_episode`.
+
+    Returns
+    -------
+    dict
+        ``episodes`` (count), success / collision-free success / stuck / timeout / crashed rates,
+        collisions per episode, episodes with a collision, mean replans on success and on failure,
+        median and mean steps, mean final distance, planning-time median and p95 (ms) and median EFE
+        time per candidate (us). Only ``{"episodes": 0}`` for an empty list.
+    """
     n = len(episodes)
     if n == 0:
         return {"episodes": 0}

@@ -100,12 +100,53 @@ def _run_ray(specs, workers: int, address: str | None, sink) -> None:
 def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None, scale: str = "reduced",
               workers: int = 1, executor: str = "local", address: str | None = None, limit: int | None = None,
               progress: bool = True, report: bool = True, time_limit: float | None = None) -> dict:
-    """Run (or resume) study ``name`` under ``out_dir/name``; returns the summary dict.
+    """Run (or resume) study ``name`` under ``out_dir/name``.
 
-    ``limit`` runs at most that many of the missing runs (then stops, as if interrupted).
-    ``time_limit`` (seconds, local executor) runs every run in a worker process that is killed
-    past the limit: the run is recorded in ``failed/<key>.json`` with its reason, the study goes
-    on, and a later session retries it. Without it and with one worker, runs go in-process."""
+    Finished runs are kept and skipped; an exclusive lock stops two studies writing one directory.
+
+    Parameters
+    ----------
+    name : str
+        One of ``STUDIES``: ``"exploration"``, ``"success"``, ``"goals"``, ``"drift"``, ``"slip"``,
+        ``"dropout"``, ``"obstacle"``, ``"scaling"``, ``"drone"``.
+    out_dir : str or path-like, optional
+        Parent directory of the study directory, default ``"results"``.
+    seeds, envs, methods : sequence, optional
+        Restrict the study's seeds, environments and methods.
+    scale : str, optional
+        ``"reduced"`` (default), ``"full"`` or ``"tiny"``.
+    workers : int, optional
+        Parallel workers, default 1.
+    executor : str, optional
+        ``"local"`` (processes, default) or ``"ray"``.
+    address : str, optional
+        Address of a running Ray cluster.
+    limit : int, optional
+        Run at most that many of the missing runs (then stop, as if interrupted).
+    progress : bool, optional
+        Show progress, default True.
+    report : bool, optional
+        Write the report table when there are results, default True.
+    time_limit : float, optional
+        Seconds per run (local executor): each run goes to a worker process that is killed past the
+        limit; the run is recorded in ``failed/<key>.json`` with its reason, the study goes on, and a
+        later session retries it. Without it and with one worker, runs go in-process.
+
+    Returns
+    -------
+    dict
+        ``study_dir``, ``complete``, ``runs``, ``total``, ``wall_s``, ``failed``, ``duplicates`` and,
+        with a report, ``table``.
+
+    Raises
+    ------
+    ValueError
+        For an unknown study or scale.
+    RuntimeError
+        If the Ray executor is asked for without ``ray`` installed.
+    StudyBusyError
+        If another process is running a study in that directory.
+    """
     if executor == "ray":
         require_ray()  # before any directory is made
     plan = study_plan(name, scale, envs=envs, seeds=seeds, methods=methods)
@@ -249,6 +290,18 @@ def run_from_args(args) -> int:
 
 
 def main(argv=None) -> int:
+    """Command-line entry point: ``python -m cogmap.study ARGS`` is ``cogmap reproduce ARGS``.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments after the program name; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        Exit status.
+    """
     from cogmap.cli import main as cli_main  # one-line errors, --debug
 
     return cli_main(["reproduce", *(sys.argv[1:] if argv is None else argv)])
