@@ -24,7 +24,7 @@ def _explore(args) -> int:
     out = Path(args.out)
     noise = OdometryNoise(slip=args.slip, heading_bias=args.heading_bias)
     metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
-                      patience=args.patience, noise=noise)
+                      patience=args.patience, noise=noise, checkpoint_every=args.checkpoint_every, resume=args.resume)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
     return 0
@@ -102,7 +102,8 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.add_argument("--checkpoint-every", type=positive_int, default=10, metavar="N",
                    help="save the exploration state every N decisions, for --resume (default: 10)")
-    add_run_options(e)
+    add_run_options(e, resume_help="continue the exploration in --out from its last checkpoint, with the settings "
+                                   "in its run.json")
     e.set_defaults(func=_explore, out_dir=lambda a: Path(a.out))
 
     g = sub.add_parser("goal", help="reach a goal observation with a model from an exploration run")

@@ -158,28 +158,102 @@ class Done:
         return self.patience > 0 and (self.quiet >= self.patience or self.seen_all >= self.SEEN_ALL)
 
 
+CHECKPOINT = "checkpoint"
+#: the simulator's state a checkpoint keeps (everything that changes as the robot moves)
+SIM_STATE = ("pose", "odom", "rng", "step_count", "path", "odom_path", "scheduled", "faults")
+
+
+def save_state(out: Path, sim, agent: AIMAPPAgent, done: Done, ep: Episode, moved, distance: float) -> Path:
+    """Checkpoint the exploration after a decision (:mod:`cogmap.checkpoint`: the model in its own
+    format, the rest as JSON + npz)."""
+    from cogmap.checkpoint import save_checkpoint
+
+    tracker = coverage_tracker(sim)
+    return save_checkpoint(out / CHECKPOINT, {
+        "agent": agent, "done": done, "episode": ep, "moved": moved, "distance": float(distance),
+        "coverage_seen": tracker.seen, "sim": {k: getattr(sim, k) for k in SIM_STATE},
+    })
+
+
+def restore_state(path: Path, sim) -> tuple[AIMAPPAgent, Done, Episode, bool | None, float]:
+    """Put ``sim`` (built afresh for the same layout and seed) back where the checkpoint left it and
+    return the agent, the end rule, the episode so far, the last motion outcome and the distance."""
+    from cogmap.checkpoint import load_checkpoint
+
+    st = load_checkpoint(path)
+    for k, v in st["sim"].items():
+        setattr(sim, k, v)
+    sim.scene.set_robot(sim.pose)
+    sim._cache = {}
+    coverage_tracker(sim).seen = st["coverage_seen"]
+    return st["agent"], st["done"], st["episode"], st["moved"], st["distance"]
+
+
 def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: Path | str | None = None,
-            config: AgentConfig | None = None, progress: bool = True, noise=None, patience: int = 20) -> dict:
+            config: AgentConfig | None = None, progress: bool = True, noise=None, patience: int = 20,
+            checkpoint_every: int = 10, resume: bool = False) -> dict:
     """The main job: explore ``env`` for at most ``steps`` decisions (ending early once the agent
     has nothing left to visit for ``patience`` decisions; 0 never ends early) and write the run
-    directory."""
+    directory.
+
+    With ``out``, the state is checkpointed to ``out/checkpoint`` every ``checkpoint_every``
+    decisions (removed once the run has finished and written its files). ``resume=True`` continues
+    the run in ``out`` from its last checkpoint with the settings recorded in its ``run.json`` (the
+    other arguments are ignored), or from the start when it stopped before its first checkpoint.
+    """
     from cogmap.envs import OdometryNoise
 
+    from .checkpoint import find_checkpoint
     from .runs import write_manifest
 
+    if resume:
+        if out is None:
+            raise ValueError("resume needs the run directory (out)")
+        out = Path(out)
+        try:
+            manifest = json.loads((out / "run.json").read_text())
+        except (OSError, ValueError):
+            raise ValueError(f"{out}: no readable run.json to resume from") from None
+        if manifest.get("command") != "explore":
+            raise ValueError(f"{out}: not an exploration run (run.json says {manifest.get('command')!r})")
+        if (out / "metrics.json").exists():
+            raise ValueError(f"{out}: the run has finished (metrics.json); nothing to resume")
+        env, steps, seed, patience = manifest["env"], manifest["steps"], manifest["seed"], manifest["patience"]
+        config = AgentConfig.from_dict(manifest["config"])
+        noise = OdometryNoise(**manifest["noise"])
+        checkpoint_every = manifest.get("checkpoint_every", checkpoint_every)
     cfg = config or default_config(env)
     sim = make_sim(env, cfg, seed, noise)
     try:
-        agent = AIMAPPAgent(cfg, seed=seed)
-        if out is not None:
-            out = Path(out)
-            write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed, patience=patience,
-                           config=cfg.to_dict(), noise=asdict(noise or OdometryNoise()))
-        done = Done(agent, patience)
-        ep = run_agent(sim, agent, steps, progress, stop=done)
+        found = find_checkpoint(out / CHECKPOINT) if resume else None
+        if found is not None:
+            agent, done, ep, moved, distance = restore_state(found, sim)
+            json_path = out / "run.json"
+            manifest = json.loads(json_path.read_text())
+            manifest.setdefault("resumed_at", []).append(len(ep.rows))
+            json_path.write_text(json.dumps(manifest, indent=1))
+        else:
+            agent = AIMAPPAgent(cfg, seed=seed)
+            done, ep, moved, distance = Done(agent, patience), Episode(), None, None
+            if out is not None and not resume:
+                out = Path(out)
+                write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed,
+                               patience=patience, checkpoint_every=checkpoint_every, config=cfg.to_dict(),
+                               noise=asdict(noise or OdometryNoise()))
+
+        def checkpoint(ep, moved, distance):
+            if len(ep.rows) % checkpoint_every == 0:
+                save_state(out, sim, agent, done, ep, moved, distance)
+
+        ep = run_episode(sim, AgentPolicy(agent), steps - len(ep.rows), progress=progress, episode=ep, stop=done,
+                         desc="explore", after_step=checkpoint if out is not None else None, moved=moved,
+                         distance=distance)
         metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.finished}
         if out is not None:
             write_run(out, sim, agent, ep, metrics)
+            import shutil
+
+            shutil.rmtree(out / CHECKPOINT, ignore_errors=True)
         return metrics
     finally:
         sim.close()

@@ -149,6 +149,12 @@ CASES = [
     ("cli", "cogmap reproduce exploration --workers 0", _cli("reproduce", "exploration", "--workers", "0")),
     ("cli", "cogmap compare-inference --model MISSING.npz", _cli("compare-inference", "--model", "<dir>/m.npz")),
     ("cli", "cogmap goal --run MISSING_DIR", _cli("goal", "--run", "<dir>/run", "--goal-obs", "0")),
+    ("cli", "cogmap explore --out NON_EMPTY_DIR (neither --resume nor --force)",
+     lambda d: (Path(d, "old.txt").write_text("x"), main(["explore", "--out", d, "--quiet"]))[1]),
+    ("cli", "cogmap explore --resume --force", _cli("explore", "--out", "<dir>", "--resume", "--force")),
+    ("cli", "cogmap explore --resume on an empty directory", _cli("explore", "--out", "<dir>", "--resume")),
+    ("cli", "cogmap goal --resume (not supported)", _cli("goal", "--run", "<dir>", "--goal-obs", "0", "--resume")),
+    ("cli", "cogmap explore --time-limit -1", _cli("explore", "--time-limit", "-1")),
 ]
 
 
