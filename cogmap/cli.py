@@ -30,6 +30,14 @@ def _explore(args) -> int:
     return 0
 
 
+def _explore_check(args) -> None:
+    """The environment exists (a layout file is read and validated) before anything starts."""
+    if not args.resume:
+        from .explore import resolve_layout
+
+        resolve_layout(args.env)
+
+
 def _goal(args) -> int:
     from .goal import reach_goal
 
@@ -87,7 +95,10 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
-    e.add_argument("--env", default="mini_warehouse", help="layout name or registered id (default: mini_warehouse)")
+    e.add_argument("--env", default="mini_warehouse",
+                   help="layout name, registered id, or your own building: a layout file (.json) or a plan "
+                        "image (.png, dark = wall, 0.05 m per pixel); see docs/tutorial-aimapp.md "
+                        "(default: mini_warehouse)")
     e.add_argument("--steps", type=positive_int, default=150, help="at most this many decisions (default: 150)")
     e.add_argument("--patience", type=nonnegative_int, default=20,
                    help="end once the map has not grown and no state was visited for the first time in this "
@@ -104,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="save the exploration state every N decisions, for --resume (default: 10)")
     add_run_options(e, resume_help="continue the exploration in --out from its last checkpoint, with the settings "
                                    "in its run.json")
-    e.set_defaults(func=_explore, out_dir=lambda a: Path(a.out))
+    e.set_defaults(func=_explore, out_dir=lambda a: Path(a.out), precheck=_explore_check)
 
     g = sub.add_parser("goal", help="reach a goal observation with a model from an exploration run")
     g.add_argument("--run", required=True, help="directory written by 'cogmap explore'")

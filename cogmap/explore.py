@@ -29,7 +29,10 @@ TRAJ_FIELDS = [
 
 
 def layout_name(env: str) -> str:
-    """Accept a layout name (``mini_warehouse``) or a registered id (``cogmap/MiniWarehouse-v0``)."""
+    """Accept a layout name (``mini_warehouse``), a registered id (``cogmap/MiniWarehouse-v0``) or a
+    layout file (``building.json`` or a ``plan.png``; returned as an absolute path, so a run's
+    ``run.json`` finds it again from anywhere)."""
+    from cogmap.envs.layout_file import is_layout_file
     from cogmap.envs.layouts import LAYOUTS
     from cogmap.envs.registry import LAYOUT_IDS
 
@@ -37,7 +40,19 @@ def layout_name(env: str) -> str:
         return LAYOUT_IDS[env]
     if env in LAYOUTS:
         return env
-    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)} or {sorted(LAYOUT_IDS)}")
+    if is_layout_file(env):
+        return str(Path(env).resolve())
+    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)}, {sorted(LAYOUT_IDS)} "
+                     f"or a layout file (.json or .png)")
+
+
+def resolve_layout(env: str):
+    """The :class:`~cogmap.envs.layouts.Layout` that ``env`` names (see :func:`layout_name`)."""
+    from cogmap.envs import make_layout
+    from cogmap.envs.layout_file import is_layout_file, load_layout
+
+    name = layout_name(env)
+    return load_layout(name) if is_layout_file(name) else make_layout(name)
 
 
 def default_config(env: str) -> AgentConfig:
@@ -50,11 +65,11 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
     """The room, with the start pose chosen by the seed: every seed starts somewhere else, as in
     the paper's protocol (the layout's start poses first, then poses sampled from the free
     space; :func:`cogmap.starts.seed_start`)."""
-    from cogmap.envs import NavSim, OdometryNoise, SimConfig, make_layout
+    from cogmap.envs import NavSim, OdometryNoise, SimConfig
 
     from .starts import seed_start
 
-    layout = make_layout(layout_name(env))
+    layout = resolve_layout(env)
     sim_cfg = SimConfig(step_length=cfg.influence_radius, obstacle_margin=cfg.obstacle_margin,
                         noise=noise or OdometryNoise())
     return NavSim(layout, sim_cfg, seed=seed, start=seed_start(layout, seed, sim_cfg.robot_radius))

@@ -122,12 +122,16 @@ def run_command(args, command: str, out: Path | None) -> int:
     """Prepare the run directory, then run ``args.func(args)`` under the time limit."""
     from .study.supervisor import run_one
 
+    check = getattr(args, "precheck", None)
+    if check is not None:  # bad input is refused here, before a child starts or a directory is touched
+        check(args)
     prepare_out(out, command, args.force, args.resume, args.resumable)
     limit = args.time_limit
     if not limit or getattr(args, "debug", False):
         return args.func(args)
     try:
-        plain = argparse.Namespace(**{k: v for k, v in vars(args).items() if k != "out_dir"})  # picklable
+        local = ("out_dir", "precheck")  # functions of the parser, not picklable
+        plain = argparse.Namespace(**{k: v for k, v in vars(args).items() if k not in local})
         ok, result = run_one(_child, {"args": plain}, limit)
     except KeyboardInterrupt:
         write_failed(out, command, "interrupted (Ctrl-C)", time_limit_s=limit)

@@ -32,6 +32,12 @@ class Layout:
     shapes: tuple[Shape, ...]
     starts: tuple[Pose, ...]
     paper_area: float | None = None
+    texture_seed: int | None = None  # None: textures follow the name alone
+
+    @property
+    def texture_name(self) -> str:
+        """What seeds the textures (see `textures`): the name, and the texture seed when given."""
+        return self.name if self.texture_seed is None else f"{self.name}#{self.texture_seed}"
 
     def shape(self, name: str) -> Shape:
         for s in self.shapes:
