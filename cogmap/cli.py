@@ -97,7 +97,8 @@ def build_parser() -> argparse.ArgumentParser:
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
     e.add_argument("--env", default="mini_warehouse",
                    help="layout name, registered id, or your own building: a layout file (.json) or a plan "
-                        "image (.png, dark = wall, 0.05 m per pixel); see docs/tutorial-aimapp.md "
+                        "image (.png, dark = wall, 0.05 m per pixel), or a procedural building:KIND:SEED (KIND: "
+                        "corridor, office, L, T, U, hall); see docs/tutorial-aimapp.md "
                         "(default: mini_warehouse)")
     e.add_argument("--steps", type=positive_int, default=150, help="at most this many decisions (default: 150)")
     e.add_argument("--patience", type=nonnegative_int, default=20,

@@ -29,9 +29,10 @@ TRAJ_FIELDS = [
 
 
 def layout_name(env: str) -> str:
-    """Accept a layout name (``mini_warehouse``), a registered id (``cogmap/MiniWarehouse-v0``) or a
-    layout file (``building.json`` or a ``plan.png``; returned as an absolute path, so a run's
-    ``run.json`` finds it again from anywhere)."""
+    """Accept a layout name (``mini_warehouse``), a registered id (``cogmap/MiniWarehouse-v0``), a
+    procedural building (``building:office:3``, see :func:`building_spec`) or a layout file
+    (``building.json`` or a ``plan.png``; returned as an absolute path, so a run's ``run.json`` finds
+    it again from anywhere)."""
     from cogmap.envs.layout_file import is_layout_file
     from cogmap.envs.layouts import LAYOUTS
     from cogmap.envs.registry import LAYOUT_IDS
@@ -42,8 +43,22 @@ def layout_name(env: str) -> str:
         return env
     if is_layout_file(env):
         return str(Path(env).resolve())
-    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)}, {sorted(LAYOUT_IDS)} "
-                     f"or a layout file (.json or .png)")
+    if env.startswith("building:"):
+        building_spec(env)  # checked here
+        return env
+    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)}, {sorted(LAYOUT_IDS)}, "
+                     f"building:KIND:SEED or a layout file (.json or .png)")
+
+
+def building_spec(env: str) -> tuple[str, int]:
+    """``building:KIND:SEED`` (a procedural building, :mod:`cogmap.envs.buildings`) as (kind, seed)."""
+    from cogmap.envs.buildings import KINDS
+
+    parts = env.split(":")
+    if len(parts) != 3 or parts[1] not in KINDS or not parts[2].isdigit():
+        raise ValueError(f"expected building:KIND:SEED with KIND one of {list(KINDS)} and SEED an integer >= 0, "
+                         f"got {env!r}")
+    return parts[1], int(parts[2])
 
 
 def resolve_layout(env: str):
@@ -52,7 +67,12 @@ def resolve_layout(env: str):
     from cogmap.envs.layout_file import is_layout_file, load_layout
 
     name = layout_name(env)
-    return load_layout(name) if is_layout_file(name) else make_layout(name)
+    if is_layout_file(name):
+        return load_layout(name)
+    if name.startswith("building:"):
+        kind, seed = building_spec(name)
+        return make_layout("building", seed, kind=kind)
+    return make_layout(name)
 
 
 def default_config(env: str) -> AgentConfig:

@@ -372,6 +372,13 @@ def random_rooms(seed: int = 0, n_x: int = 3, n_y: int = 2, size=(3.0, 6.0),
     return b.layout("random_rooms", bounds, starts, None)
 
 
+def _building(seed: int = 0, kind: str = "office") -> Layout:
+    """The procedural building family (:mod:`cogmap.envs.buildings`)."""
+    from .buildings import building
+
+    return building(seed, kind)
+
+
 LAYOUTS: dict[str, Callable[..., Layout]] = {
     "mini_warehouse": mini_warehouse,
     "small_warehouse": small_warehouse,
@@ -381,6 +388,7 @@ LAYOUTS: dict[str, Callable[..., Layout]] = {
     "parking_lot": parking_lot,
     "aisle_warehouse": aisle_warehouse,
     "random_rooms": random_rooms,
+    "building": _building,
 }
 
 
