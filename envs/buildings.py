@@ -13,7 +13,8 @@ centres, at least 1 m apart).
 
     make_layout("building", seed=3, kind="office")    # or building(3, "office")
 
-Free areas (m2, reachable from the first start, seeds 0-49): see :data:`AREA_RANGE`.
+Free areas (m2, reachable from the first start): see :data:`AREA_RANGE`. All 300 buildings of
+seeds 0-49 pass the checks.
 """
 
 from __future__ import annotations
@@ -25,9 +26,10 @@ from .layouts import OPENING, WALL, Layout, _Builder
 KINDS = ("corridor", "office", "L", "T", "U", "hall")
 U = 0.1  # lattice step (m): every wall lies on a multiple of it
 MIN_STARTS = 5
-#: free area (m2) each kind stays within (checked by the tests over seeds)
-AREA_RANGE = {"corridor": (60, 220), "office": (120, 330), "L": (70, 260), "T": (80, 300), "U": (90, 320),
-              "hall": (110, 330)}
+#: free area (m2) each kind stays within (checked by the tests); measured over seeds 0-49: corridor
+#: 105-175, office 215-311, L 110-176, T 120-180, U 147-217, hall 117-235
+AREA_RANGE = {"corridor": (90, 190), "office": (190, 330), "L": (95, 195), "T": (105, 200), "U": (130, 235),
+              "hall": (100, 255)}
 OUTER = (0.82, 0.82, 0.78)
 
 
