@@ -214,6 +214,8 @@ CASES += [
                                                                    load_layout(Path(d, "b.json")))[1]),
     ("layout file", "PNG plan of 100000 x 100000 pixels (refused from its header)", _huge_png),
     ("cli", "cogmap explore --env MISSING.json", _cli("explore", "--env", "<dir>/missing.json", "--out", "<dir>/run")),
+    ("cli", "cogmap explore --env building:V:1 (unknown procedural kind)",
+     _cli("explore", "--env", "building:V:1", "--out", "<dir>/run")),
 ]
 
 
