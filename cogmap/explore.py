@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import json
+import warnings
 from dataclasses import asdict
 from pathlib import Path
 
@@ -238,7 +239,7 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
     """
     from cogmap.envs import OdometryNoise
 
-    from .checkpoint import find_checkpoint
+    from .checkpoint import CheckpointError, find_checkpoint
     from .runs import write_manifest
 
     if resume:
@@ -276,9 +277,16 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
                                patience=patience, checkpoint_every=checkpoint_every, config=cfg.to_dict(),
                                noise=asdict(noise or OdometryNoise()))
 
+        failed_checkpoint: list[str] = []
+
         def checkpoint(ep, moved, distance):
-            if len(ep.rows) % checkpoint_every == 0:
-                save_state(out, sim, agent, done, ep, moved, distance)
+            if len(ep.rows) % checkpoint_every == 0 and not failed_checkpoint:
+                try:
+                    save_state(out, sim, agent, done, ep, moved, distance)
+                except CheckpointError as err:  # a state the codec cannot write: the run goes on without
+                    failed_checkpoint.append(str(err))
+                    warnings.warn(f"exploration checkpoints stopped (--resume will not be possible): {err}",
+                                  stacklevel=2)
 
         ep = run_episode(sim, AgentPolicy(agent), steps - len(ep.rows), progress=progress, episode=ep, stop=done,
                          desc="explore", after_step=checkpoint if out is not None else None, moved=moved,
