@@ -14,6 +14,7 @@ from pathlib import Path
 
 from . import __version__
 from .argtypes import OneLineParser, nonnegative_int, positive_int
+from .runguard import add_run_options, run_command
 
 
 def _explore(args) -> int:
@@ -23,10 +24,18 @@ def _explore(args) -> int:
     out = Path(args.out)
     noise = OdometryNoise(slip=args.slip, heading_bias=args.heading_bias)
     metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
-                      patience=args.patience, noise=noise)
+                      patience=args.patience, noise=noise, checkpoint_every=args.checkpoint_every, resume=args.resume)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
     return 0
+
+
+def _explore_check(args) -> None:
+    """The environment exists (a layout file is read and validated) before anything starts."""
+    if not args.resume:
+        from .explore import resolve_layout
+
+        resolve_layout(args.env)
 
 
 def _goal(args) -> int:
@@ -86,7 +95,11 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True)
 
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
-    e.add_argument("--env", default="mini_warehouse", help="layout name or registered id (default: mini_warehouse)")
+    e.add_argument("--env", default="mini_warehouse",
+                   help="layout name, registered id, or your own building: a layout file (.json) or a plan "
+                        "image (.png, dark = wall, 0.05 m per pixel), or a procedural building:KIND:SEED (KIND: "
+                        "corridor, office, L, T, U, hall); see docs/tutorial-aimapp.md "
+                        "(default: mini_warehouse)")
     e.add_argument("--steps", type=positive_int, default=150, help="at most this many decisions (default: 150)")
     e.add_argument("--patience", type=nonnegative_int, default=20,
                    help="end once the map has not grown and no state was visited for the first time in this "
@@ -99,7 +112,11 @@ def build_parser() -> argparse.ArgumentParser:
                    help="odometry drift: yaw error in rad per metre travelled (default: 0)")
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
-    e.set_defaults(func=_explore)
+    e.add_argument("--checkpoint-every", type=positive_int, default=10, metavar="N",
+                   help="save the exploration state every N decisions, for --resume (default: 10)")
+    add_run_options(e, resume_help="continue the exploration in --out from its last checkpoint, with the settings "
+                                   "in its run.json")
+    e.set_defaults(func=_explore, out_dir=lambda a: Path(a.out), precheck=_explore_check)
 
     g = sub.add_parser("goal", help="reach a goal observation with a model from an exploration run")
     g.add_argument("--run", required=True, help="directory written by 'cogmap explore'")
@@ -110,7 +127,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--seed", type=int, default=0)
     g.add_argument("--out", default=None, help="directory for the goal run (default: <run>/goal)")
     g.add_argument("--quiet", action="store_true")
-    g.set_defaults(func=_goal)
+    add_run_options(g)
+    g.set_defaults(func=_goal, out_dir=lambda a: Path(a.out) if a.out else Path(a.run) / "goal")
 
     c = sub.add_parser("compare-inference", help="run every registered inference scheme on one model")
     c.add_argument("--model", default="tmaze",
@@ -134,7 +152,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="top/side PNGs of the first N episodes (default: 3)")
     f.add_argument("--out", default=None, help="run directory (default: print the summary only)")
     f.add_argument("--quiet", action="store_true")
-    f.set_defaults(func=_drone_fly)
+    add_run_options(f)
+    f.set_defaults(func=_drone_fly, out_dir=lambda a: Path(a.out) if a.out else None)
 
     v = sub.add_parser("dvbf", help="DVBF-LM in the LiDAR mazes")
     vsub = v.add_subparsers(dest="dvbf_command", required=True)
@@ -147,7 +166,8 @@ def build_parser() -> argparse.ArgumentParser:
     ds.add_argument("--seed", type=int, default=0, help="traversal, noise and filter seed (default: 0)")
     ds.add_argument("--out", default="runs/dvbf-slam", help="run directory (default: runs/dvbf-slam)")
     ds.add_argument("--quiet", action="store_true")
-    ds.set_defaults(func=_dvbf)
+    add_run_options(ds)
+    ds.set_defaults(func=_dvbf, out_dir=lambda a: Path(a.out))
 
     from .study.runner import build_parser as study_arguments
 
@@ -171,6 +191,8 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     prog = f"cogmap {args.command}" + (f" {args.drone_command}" if args.command == "drone" else "")
     try:
+        if hasattr(args, "out_dir"):  # a run command: run directory checks and a wall-clock limit
+            return run_command(args, prog, args.out_dir(args))
         return args.func(args)
     except KeyboardInterrupt:
         if args.debug:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import json
+import warnings
 from dataclasses import asdict
 from pathlib import Path
 
@@ -29,7 +30,11 @@ TRAJ_FIELDS = [
 
 
 def layout_name(env: str) -> str:
-    """Accept a layout name (``mini_warehouse``) or a registered id (``cogmap/MiniWarehouse-v0``)."""
+    """Accept a layout name (``mini_warehouse``), a registered id (``cogmap/MiniWarehouse-v0``), a
+    procedural building (``building:office:3``, see :func:`building_spec`) or a layout file
+    (``building.json`` or a ``plan.png``; returned as an absolute path, so a run's ``run.json`` finds
+    it again from anywhere)."""
+    from cogmap.envs.layout_file import is_layout_file
     from cogmap.envs.layouts import LAYOUTS
     from cogmap.envs.registry import LAYOUT_IDS
 
@@ -37,7 +42,38 @@ def layout_name(env: str) -> str:
         return LAYOUT_IDS[env]
     if env in LAYOUTS:
         return env
-    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)} or {sorted(LAYOUT_IDS)}")
+    if is_layout_file(env):
+        return str(Path(env).resolve())
+    if env.startswith("building:"):
+        building_spec(env)  # checked here
+        return env
+    raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)}, {sorted(LAYOUT_IDS)}, "
+                     f"building:KIND:SEED or a layout file (.json or .png)")
+
+
+def building_spec(env: str) -> tuple[str, int]:
+    """``building:KIND:SEED`` (a procedural building, :mod:`cogmap.envs.buildings`) as (kind, seed)."""
+    from cogmap.envs.buildings import KINDS
+
+    parts = env.split(":")
+    if len(parts) != 3 or parts[1] not in KINDS or not parts[2].isdigit():
+        raise ValueError(f"expected building:KIND:SEED with KIND one of {list(KINDS)} and SEED an integer >= 0, "
+                         f"got {env!r}")
+    return parts[1], int(parts[2])
+
+
+def resolve_layout(env: str):
+    """The :class:`~cogmap.envs.layouts.Layout` that ``env`` names (see :func:`layout_name`)."""
+    from cogmap.envs import make_layout
+    from cogmap.envs.layout_file import is_layout_file, load_layout
+
+    name = layout_name(env)
+    if is_layout_file(name):
+        return load_layout(name)
+    if name.startswith("building:"):
+        kind, seed = building_spec(name)
+        return make_layout("building", seed, kind=kind)
+    return make_layout(name)
 
 
 def default_config(env: str) -> AgentConfig:
@@ -50,11 +86,11 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
     """The room, with the start pose chosen by the seed: every seed starts somewhere else, as in
     the paper's protocol (the layout's start poses first, then poses sampled from the free
     space; :func:`cogmap.starts.seed_start`)."""
-    from cogmap.envs import NavSim, OdometryNoise, SimConfig, make_layout
+    from cogmap.envs import NavSim, OdometryNoise, SimConfig
 
     from .starts import seed_start
 
-    layout = make_layout(layout_name(env))
+    layout = resolve_layout(env)
     sim_cfg = SimConfig(step_length=cfg.influence_radius, obstacle_margin=cfg.obstacle_margin,
                         noise=noise or OdometryNoise())
     return NavSim(layout, sim_cfg, seed=seed, start=seed_start(layout, seed, sim_cfg.robot_radius))
@@ -158,28 +194,109 @@ class Done:
         return self.patience > 0 and (self.quiet >= self.patience or self.seen_all >= self.SEEN_ALL)
 
 
+CHECKPOINT = "checkpoint"
+#: the simulator's state a checkpoint keeps (everything that changes as the robot moves)
+SIM_STATE = ("pose", "odom", "rng", "step_count", "path", "odom_path", "scheduled", "faults")
+
+
+def save_state(out: Path, sim, agent: AIMAPPAgent, done: Done, ep: Episode, moved, distance: float) -> Path:
+    """Checkpoint the exploration after a decision (:mod:`cogmap.checkpoint`: the model in its own
+    format, the rest as JSON + npz)."""
+    from cogmap.checkpoint import save_checkpoint
+
+    tracker = coverage_tracker(sim)
+    return save_checkpoint(out / CHECKPOINT, {
+        "agent": agent, "done": done, "episode": ep, "moved": moved, "distance": float(distance),
+        "coverage_seen": tracker.seen, "sim": {k: getattr(sim, k) for k in SIM_STATE},
+    })
+
+
+def restore_state(path: Path, sim) -> tuple[AIMAPPAgent, Done, Episode, bool | None, float]:
+    """Put ``sim`` (built afresh for the same layout and seed) back where the checkpoint left it and
+    return the agent, the end rule, the episode so far, the last motion outcome and the distance."""
+    from cogmap.checkpoint import load_checkpoint
+
+    st = load_checkpoint(path)
+    for k, v in st["sim"].items():
+        setattr(sim, k, v)
+    sim.scene.set_robot(sim.pose)
+    sim._cache = {}
+    coverage_tracker(sim).seen = st["coverage_seen"]
+    return st["agent"], st["done"], st["episode"], st["moved"], st["distance"]
+
+
 def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: Path | str | None = None,
-            config: AgentConfig | None = None, progress: bool = True, noise=None, patience: int = 20) -> dict:
+            config: AgentConfig | None = None, progress: bool = True, noise=None, patience: int = 20,
+            checkpoint_every: int = 10, resume: bool = False) -> dict:
     """The main job: explore ``env`` for at most ``steps`` decisions (ending early once the agent
     has nothing left to visit for ``patience`` decisions; 0 never ends early) and write the run
-    directory."""
+    directory.
+
+    With ``out``, the state is checkpointed to ``out/checkpoint`` every ``checkpoint_every``
+    decisions (removed once the run has finished and written its files). ``resume=True`` continues
+    the run in ``out`` from its last checkpoint with the settings recorded in its ``run.json`` (the
+    other arguments are ignored), or from the start when it stopped before its first checkpoint.
+    """
     from cogmap.envs import OdometryNoise
 
+    from .checkpoint import CheckpointError, find_checkpoint
     from .runs import write_manifest
 
+    if resume:
+        if out is None:
+            raise ValueError("resume needs the run directory (out)")
+        out = Path(out)
+        try:
+            manifest = json.loads((out / "run.json").read_text())
+        except (OSError, ValueError):
+            raise ValueError(f"{out}: no readable run.json to resume from") from None
+        if manifest.get("command") != "explore":
+            raise ValueError(f"{out}: not an exploration run (run.json says {manifest.get('command')!r})")
+        if (out / "metrics.json").exists():
+            raise ValueError(f"{out}: the run has finished (metrics.json); nothing to resume")
+        env, steps, seed, patience = manifest["env"], manifest["steps"], manifest["seed"], manifest["patience"]
+        config = AgentConfig.from_dict(manifest["config"])
+        noise = OdometryNoise(**manifest["noise"])
+        checkpoint_every = manifest.get("checkpoint_every", checkpoint_every)
     cfg = config or default_config(env)
     sim = make_sim(env, cfg, seed, noise)
     try:
-        agent = AIMAPPAgent(cfg, seed=seed)
-        if out is not None:
-            out = Path(out)
-            write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed, patience=patience,
-                           config=cfg.to_dict(), noise=asdict(noise or OdometryNoise()))
-        done = Done(agent, patience)
-        ep = run_agent(sim, agent, steps, progress, stop=done)
+        found = find_checkpoint(out / CHECKPOINT) if resume else None
+        if found is not None:
+            agent, done, ep, moved, distance = restore_state(found, sim)
+            json_path = out / "run.json"
+            manifest = json.loads(json_path.read_text())
+            manifest.setdefault("resumed_at", []).append(len(ep.rows))
+            json_path.write_text(json.dumps(manifest, indent=1))
+        else:
+            agent = AIMAPPAgent(cfg, seed=seed)
+            done, ep, moved, distance = Done(agent, patience), Episode(), None, None
+            if out is not None and not resume:
+                out = Path(out)
+                write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed,
+                               patience=patience, checkpoint_every=checkpoint_every, config=cfg.to_dict(),
+                               noise=asdict(noise or OdometryNoise()))
+
+        failed_checkpoint: list[str] = []
+
+        def checkpoint(ep, moved, distance):
+            if len(ep.rows) % checkpoint_every == 0 and not failed_checkpoint:
+                try:
+                    save_state(out, sim, agent, done, ep, moved, distance)
+                except CheckpointError as err:  # a state the codec cannot write: the run goes on without
+                    failed_checkpoint.append(str(err))
+                    warnings.warn(f"exploration checkpoints stopped (--resume will not be possible): {err}",
+                                  stacklevel=2)
+
+        ep = run_episode(sim, AgentPolicy(agent), steps - len(ep.rows), progress=progress, episode=ep, stop=done,
+                         desc="explore", after_step=checkpoint if out is not None else None, moved=moved,
+                         distance=distance)
         metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.finished}
         if out is not None:
             write_run(out, sim, agent, ep, metrics)
+            import shutil
+
+            shutil.rmtree(out / CHECKPOINT, ignore_errors=True)
         return metrics
     finally:
         sim.close()

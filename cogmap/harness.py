@@ -187,7 +187,8 @@ def execute(sim, command: Command) -> bool:
 
 
 def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, episode: Episode | None = None,
-                on_step=None, stop=None, stop_coverage: float | None = None, desc: str | None = None) -> Episode:
+                on_step=None, stop=None, stop_coverage: float | None = None, desc: str | None = None,
+                after_step=None, moved: bool | None = None, distance: float | None = None) -> Episode:
     """Drive ``policy`` in ``sim`` for at most ``steps`` decisions, tracking LiDAR coverage.
 
     Ends early when the policy reports ``done``, when ``stop(decision)`` is true after a step was
@@ -213,6 +214,13 @@ def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, epis
         Coverage in [0, 1] at which to stop.
     desc : str, optional
         Progress-bar description; default ``policy.label``.
+    after_step : callable, optional
+        ``after_step(ep, moved, distance)`` runs at the end of every step that does not end the
+        episode (where a checkpoint captures the whole loop state).
+    moved : bool, optional
+        Outcome of the last motion command, when resuming a loop from such a point.
+    distance : float, optional
+        Distance travelled so far (m), when resuming.
 
     Returns
     -------
@@ -223,8 +231,7 @@ def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, epis
 
     ep = episode if episode is not None else Episode()
     tracker = coverage_tracker(sim)
-    moved: bool | None = None
-    dist = ep.distance[-1] if ep.distance else 0.0
+    dist = distance if distance is not None else (ep.distance[-1] if ep.distance else 0.0)
     bar = tqdm(range(steps), disable=not progress, desc=desc or policy.label, unit="step", leave=True)
     for _ in bar:
         sweep(sim, tracker)
@@ -254,6 +261,8 @@ def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, epis
         dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
         if stop is not None and stop(cmd.decision):
             break
+        if after_step is not None:
+            after_step(ep, moved, dist)
     sweep(sim, tracker)
     ep.coverage.append(tracker.coverage)
     ep.distance.append(dist)

@@ -21,6 +21,7 @@ import numpy as np
 
 from cogmap import inference
 from cogmap.cli import main
+from cogmap.envs.layout_file import LayoutFileError, load_layout
 from cogmap.genmodel import Factor, Modality, ModelSpec, SpecError, compile
 from cogmap.genmodel.io import load, save, write_files
 from cogmap.inference import InferenceError
@@ -149,6 +150,72 @@ CASES = [
     ("cli", "cogmap reproduce exploration --workers 0", _cli("reproduce", "exploration", "--workers", "0")),
     ("cli", "cogmap compare-inference --model MISSING.npz", _cli("compare-inference", "--model", "<dir>/m.npz")),
     ("cli", "cogmap goal --run MISSING_DIR", _cli("goal", "--run", "<dir>/run", "--goal-obs", "0")),
+    ("cli", "cogmap explore --out NON_EMPTY_DIR (neither --resume nor --force)",
+     lambda d: (Path(d, "old.txt").write_text("x"), main(["explore", "--out", d, "--quiet"]))[1]),
+    ("cli", "cogmap explore --resume --force", _cli("explore", "--out", "<dir>", "--resume", "--force")),
+    ("cli", "cogmap explore --resume on an empty directory", _cli("explore", "--out", "<dir>", "--resume")),
+    ("cli", "cogmap goal --resume (not supported)", _cli("goal", "--run", "<dir>", "--goal-obs", "0", "--resume")),
+    ("cli", "cogmap explore --time-limit -1", _cli("explore", "--time-limit", "-1")),
+]
+
+
+def _building(edit=None, name="b.json"):
+    """Load a small valid building (docs/examples style) after ``edit``; the file lives in <dir>."""
+    def run(d):
+        b = {"name": "room", "walls": [{"from": [0, 0], "to": [6, 0]}, {"from": [6, 0], "to": [6, 4]},
+                                       {"from": [6, 4], "to": [0, 4]}, {"from": [0, 4], "to": [0, 0]},
+                                       {"from": [3, 0], "to": [3, 4], "gaps": [[1.0, 2.6]]}],
+             "furniture": [{"type": "box", "x": 1.0, "y": 3.3, "size": [1.0, 0.6]}],
+             "starts": [[1.0, 1.0, 0.0], [5.0, 2.0, 3.14]]}
+        if edit:
+            edit(b)
+        path = Path(d) / name
+        path.write_text(json.dumps(b))
+        return load_layout(path)
+    return run
+
+
+def _set_in(path, value):
+    def edit(b):
+        node = b
+        for k in path[:-1]:
+            node = node[k]
+        if value is KeyError:
+            del node[path[-1]]
+        else:
+            node[path[-1]] = value
+    return edit
+
+
+def _huge_png(d):
+    p = Path(d) / "huge.png"
+    p.write_bytes(b"\x89PNG\r\n\x1a\n" + b"\x00\x00\x00\x0dIHDR" + (100000).to_bytes(4, "big") * 2 + b"\x08" + bytes(4))
+    return load_layout(p)
+
+
+CASES += [
+    ("layout file", "missing key", _building(_set_in(["walls", 1, "to"], KeyError))),
+    ("layout file", "unknown key (a typo)", _building(_set_in(["furniture", 0, "colour"], [1, 0, 0]))),
+    ("layout file", "non-numeric size", _building(_set_in(["furniture", 0, "size"], ["wide", 1]))),
+    ("layout file", "negative size", _building(_set_in(["walls", 0, "thickness"], -0.1))),
+    ("layout file", "wall of zero length", _building(_set_in(["walls", 2, "to"], [6, 4]))),
+    ("layout file", "door gap outside its wall", _building(_set_in(["walls", 4, "gaps"], [[3.0, 5.0]]))),
+    ("layout file", "start outside the bounds", _building(_set_in(["starts", 1], [7.0, 2.0, 0.0]))),
+    ("layout file", "start inside an obstacle", _building(_set_in(["starts", 1], [1.0, 3.3, 0.0]))),
+    ("layout file", "start where the robot does not fit", _building(_set_in(["starts", 1], [5.85, 2.0, 0.0]))),
+    ("layout file", "starts that cannot reach each other", _building(_set_in(["walls", 4, "gaps"], []))),
+    ("layout file", "building open to the outside", _building(_set_in(["walls", 1, "gaps"], [[1.0, 3.0]]))),
+    ("layout file", "no free space", _building(lambda b: b.update(
+        walls=[{"from": [0, 0], "to": [0.3, 0]}, {"from": [0.3, 0], "to": [0.3, 0.3]},
+               {"from": [0.3, 0.3], "to": [0, 0.3]}, {"from": [0, 0.3], "to": [0, 0]}], furniture=[], starts=None))),
+    ("layout file", "invalid JSON", lambda d: (Path(d, "b.json").write_text("{'name': 1}"),
+                                               load_layout(Path(d, "b.json")))[1]),
+    ("layout file", "a directory in place of the file", lambda d: (Path(d, "b.json").mkdir(),
+                                                                   load_layout(Path(d, "b.json")))[1]),
+    ("layout file", "PNG plan of 100000 x 100000 pixels (refused from its header)", _huge_png),
+    ("cli", "cogmap explore --env MISSING.json", _cli("explore", "--env", "<dir>/missing.json", "--out", "<dir>/run")),
+    ("cli", "cogmap explore --env building:V:1 (unknown procedural kind)",
+     _cli("explore", "--env", "building:V:1", "--out", "<dir>/run")),
 ]
 
 
@@ -174,7 +241,7 @@ def message(call) -> str:
         try:
             with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
                 result = call(d)
-        except (SpecError, InferenceError) as exc:
+        except (SpecError, InferenceError, LayoutFileError) as exc:
             text = str(exc)
         except SystemExit as stop:
             if stop.code != 2:

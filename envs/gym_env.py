@@ -37,7 +37,7 @@ class NavEnv(gym.Env):
 
     def __init__(self, layout: str | Layout = "mini_warehouse", layout_seed: int = 0,
                  config: SimConfig | None = None, noise: OdometryNoise | dict | None = None,
-                 faults=(), render_mode: str | None = None, **config_overrides):
+                 faults=(), render_mode: str | None = None, layout_kwargs: dict | None = None, **config_overrides):
         cfg = config or SimConfig()
         if noise is not None:
             cfg = dataclasses.replace(
@@ -45,7 +45,8 @@ class NavEnv(gym.Env):
         if config_overrides:
             cfg = dataclasses.replace(cfg, **config_overrides)
         self.config = cfg
-        lay = make_layout(layout, layout_seed) if isinstance(layout, str) else layout
+        # layout_kwargs: extra arguments of the layout builder, e.g. {"kind": "T"} for "building"
+        lay = make_layout(layout, layout_seed, **(layout_kwargs or {})) if isinstance(layout, str) else layout
         self.sim = NavSim(lay, cfg, seed=0)
         self.base_faults = [tuple(f) for f in faults]
         self.render_mode = render_mode

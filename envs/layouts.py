@@ -32,6 +32,12 @@ class Layout:
     shapes: tuple[Shape, ...]
     starts: tuple[Pose, ...]
     paper_area: float | None = None
+    texture_seed: int | None = None  # None: textures follow the name alone
+
+    @property
+    def texture_name(self) -> str:
+        """What seeds the textures (see `textures`): the name, and the texture seed when given."""
+        return self.name if self.texture_seed is None else f"{self.name}#{self.texture_seed}"
 
     def shape(self, name: str) -> Shape:
         for s in self.shapes:
@@ -366,6 +372,13 @@ def random_rooms(seed: int = 0, n_x: int = 3, n_y: int = 2, size=(3.0, 6.0),
     return b.layout("random_rooms", bounds, starts, None)
 
 
+def _building(seed: int = 0, kind: str = "office") -> Layout:
+    """The procedural building family (:mod:`cogmap.envs.buildings`)."""
+    from .buildings import building
+
+    return building(seed, kind)
+
+
 LAYOUTS: dict[str, Callable[..., Layout]] = {
     "mini_warehouse": mini_warehouse,
     "small_warehouse": small_warehouse,
@@ -375,6 +388,7 @@ LAYOUTS: dict[str, Callable[..., Layout]] = {
     "parking_lot": parking_lot,
     "aisle_warehouse": aisle_warehouse,
     "random_rooms": random_rooms,
+    "building": _building,
 }
 
 

@@ -15,6 +15,7 @@ LAYOUT_IDS = {
     "cogmap/ParkingLot-v0": "parking_lot",
     "cogmap/AisleWarehouse-v0": "aisle_warehouse",
     "cogmap/RandomRooms-v0": "random_rooms",
+    "cogmap/Building-v0": "building",  # an office floor; pass layout=make_layout("building", seed, kind=...)
 }
 GRID_ID = "cogmap/GridWorld-v0"
 #: the DVBF-LM LiDAR maze (continuous controls; not part of ALL_IDS, whose envs share the discrete action set)

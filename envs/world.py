@@ -60,7 +60,7 @@ class PyBulletScene:
                 vis = p.createVisualShape(p.GEOM_MESH, vertices=v, indices=i, uvs=uv, normals=n,
                                           rgbaColor=WHITE, physicsClientId=cid)
                 self.floor = p.createMultiBody(0, -1, vis, [*centre, 0.0], physicsClientId=cid)
-                tex = layout_floor_texture(layout.name, size, FLOOR_RGBA[:3])
+                tex = layout_floor_texture(layout.texture_name, size, FLOOR_RGBA[:3])
                 self._texture(self.floor, tex, tmp / "floor.png")
             else:
                 half = [size[0] / 2, size[1] / 2, 0.01]
@@ -72,7 +72,7 @@ class PyBulletScene:
                 self.bodies[s.name] = self._add(s)
                 self.heights[s.name] = s.height
                 if textured:
-                    self._texture(self.bodies[s.name], shape_texture(layout.name, s),
+                    self._texture(self.bodies[s.name], shape_texture(layout.texture_name, s),
                                   tmp / f"shape_{k:04d}.png")
         finally:
             if tmp is not None:

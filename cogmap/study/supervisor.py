@@ -96,6 +96,12 @@ def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, 
             if finished < len(specs) and not any(p.is_alive() for p in procs):
                 spawn()  # never wait on runs with no worker left to take them
     finally:
+        if finished == len(specs):  # all idle: let them leave on their own (no lock held when they go)
+            for p in procs:
+                if p.is_alive():
+                    tasks.put(None)
+            for p in procs:
+                p.join(timeout=2.0)
         for p in procs:
             if p.is_alive():
                 p.kill()
@@ -103,3 +109,14 @@ def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, 
         for q in (tasks, results):  # release the queues' pipes and semaphores now, not at exit
             q.cancel_join_thread()
             q.close()
+
+
+def run_one(fn: Callable[[dict], dict], spec: dict, time_limit: float | None) -> tuple[bool, dict | str]:
+    """Run ``fn(spec)`` once in a supervised worker process (the mechanism of :func:`run_supervised`
+    with one run): ``(True, result)`` when it finished, ``(False, reason)`` when it raised, died or
+    exceeded ``time_limit`` seconds (the worker is then killed). Used by the command line, so that no
+    single command can hang."""
+    outcome: list = []
+    run_supervised(fn, [spec], 1, time_limit, lambda result: outcome.append((True, result)),
+                   lambda _spec, reason: outcome.append((False, reason)))
+    return outcome[0]

@@ -8,7 +8,7 @@ from cogmap.envs.registry import ALL_IDS
 
 
 def test_all_ids_registered():
-    assert len(ALL_IDS) == 9
+    assert len(ALL_IDS) == 10
     for env_id in ALL_IDS:
         assert env_id in gym.registry
     assert cenvs.LAYOUT_IDS["cogmap/House-v0"] == "house"

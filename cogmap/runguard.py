@@ -1,0 +1,150 @@
+"""What every run command shares: a wall-clock limit and run directories that lose nothing.
+
+``cogmap explore``, ``goal``, ``drone fly`` and ``dvbf slam`` take
+
+- ``--time-limit SECONDS`` (default :data:`DEFAULT_TIME_LIMIT_S`; 0 = none): the command runs in
+  a child process supervised as study runs are (:func:`cogmap.study.supervisor.run_one`); past the
+  limit the child is killed (a native call that never returns cannot be interrupted from inside),
+  the run directory keeps what was written, ``failed.json`` records why, and the command ends with
+  one line and a non-zero exit status. ``--debug`` runs the command in this process instead (so the
+  traceback and a debugger reach the error), without the limit.
+- ``--force`` / ``--resume``: a non-empty run directory is refused unless ``--force`` (clear it
+  first) or ``--resume`` (continue the run it holds; only where the command supports it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import json
+import shutil
+import sys
+import time
+from pathlib import Path
+
+from .argtypes import nonnegative_float
+
+DEFAULT_TIME_LIMIT_S = 1800.0
+FAILED = "failed.json"
+
+
+class RunDirError(ValueError):
+    """A run directory that cannot be used as asked (not empty, not a directory, ...)."""
+
+
+class RunFailed(RuntimeError):
+    """A supervised command that exceeded its time limit, died or was interrupted."""
+
+
+def add_run_options(parser, resume_help: str | None = None) -> None:
+    """``--time-limit``, ``--force`` and ``--resume`` (``resume_help`` None: refused when given)."""
+    parser.add_argument("--time-limit", type=nonnegative_float, default=DEFAULT_TIME_LIMIT_S, metavar="SECONDS",
+                        help=f"stop the run after this many seconds of wall-clock time, keep what it wrote and "
+                             f"record the reason in {FAILED} (default: {DEFAULT_TIME_LIMIT_S:g}; 0: no limit)")
+    parser.add_argument("--force", action="store_true", help="clear a non-empty run directory before writing")
+    parser.add_argument("--resume", action="store_true",
+                        help=resume_help or "not supported by this command (refused with a message)")
+    parser.set_defaults(resumable=resume_help is not None)
+
+
+def _protected(path: Path) -> bool:
+    """Directories ``--force`` never clears: the root, the home directory, the working directory or
+    any of its parents."""
+    path = path.resolve()
+    cwd = Path.cwd().resolve()
+    return path == Path(path.anchor) or path == Path.home().resolve() or path == cwd or path in cwd.parents
+
+
+def prepare_out(out: Path | None, command: str, force: bool, resume: bool, resumable: bool) -> None:
+    """Check (and with ``force`` clear) the run directory before anything runs."""
+    if resume and not resumable:
+        raise RunDirError(f"--resume is not supported by {command}; start again with --force")
+    if resume and force:
+        raise RunDirError("--resume and --force exclude each other (continue the run, or clear it)")
+    if out is None:
+        return
+    if out.exists() and not out.is_dir():
+        raise RunDirError(f"{out}: exists and is not a directory")
+    busy = out.is_dir() and any(out.iterdir())
+    if resume:
+        if not busy:
+            raise RunDirError(f"{out}: nothing to resume (the directory is empty or missing)")
+        (out / FAILED).unlink(missing_ok=True)  # the failure it recorded is being dealt with
+        return
+    if not busy:
+        return
+    if not force:
+        extra = "--resume to continue the run it holds, or --force to clear it" if resumable else \
+            f"--force to clear it (--resume is not supported by {command})"
+        raise RunDirError(f"{out}: run directory is not empty; use {extra}")
+    if _protected(out):
+        raise RunDirError(f"{out}: refusing to clear this directory with --force (use a run directory of its own)")
+    for child in out.iterdir():
+        if child.is_dir() and not child.is_symlink():
+            shutil.rmtree(child)
+        else:
+            child.unlink()
+
+
+def write_failed(out: Path | None, command: str, reason: str, **fields) -> None:
+    """``failed.json`` in the run directory: why the run stopped (what was written is kept)."""
+    if out is None:
+        return
+    out.mkdir(parents=True, exist_ok=True)
+    record = {"command": command, "reason": reason, "time": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
+              **fields}
+    (out / FAILED).write_text(json.dumps(record, indent=1))
+
+
+def _child(spec: dict) -> dict:
+    """Runs in the supervised worker: the command itself, its stdout captured for the parent."""
+    import threading
+
+    from tqdm import tqdm
+
+    from .cli import one_line
+
+    # a thread lock for the progress bars: tqdm's default includes a semaphore that a killed child
+    # would leave registered (the resource tracker then warns at exit)
+    tqdm.set_lock(threading.RLock())
+    args = spec["args"]
+    buf = io.StringIO()
+    try:
+        with contextlib.redirect_stdout(buf):
+            code = args.func(args)
+        return {"code": code, "stdout": buf.getvalue()}
+    except Exception as err:  # noqa: BLE001 - reported to the parent as one line
+        return {"error": one_line(err), "stdout": buf.getvalue()}
+
+
+def run_command(args, command: str, out: Path | None) -> int:
+    """Prepare the run directory, then run ``args.func(args)`` under the time limit."""
+    from .study.supervisor import run_one
+
+    check = getattr(args, "precheck", None)
+    if check is not None:  # bad input is refused here, before a child starts or a directory is touched
+        check(args)
+    prepare_out(out, command, args.force, args.resume, args.resumable)
+    limit = args.time_limit
+    if not limit or getattr(args, "debug", False):
+        return args.func(args)
+    try:
+        local = ("out_dir", "precheck")  # functions of the parser, not picklable
+        plain = argparse.Namespace(**{k: v for k, v in vars(args).items() if k not in local})
+        ok, result = run_one(_child, {"args": plain}, limit)
+    except KeyboardInterrupt:
+        write_failed(out, command, "interrupted (Ctrl-C)", time_limit_s=limit)
+        raise
+    if ok:
+        sys.stdout.write(result["stdout"])
+        if "error" in result:
+            if out is not None and out.is_dir() and any(out.iterdir()):
+                write_failed(out, command, result["error"], time_limit_s=limit)
+            raise RunFailed(result["error"])
+        return result["code"]
+    reason = result
+    write_failed(out, command, reason, time_limit_s=limit)
+    kept = f"; what it wrote is kept in {out} ({FAILED} says why)" if out is not None else ""
+    again = " (--resume continues it)" if args.resumable and out is not None else ""
+    raise RunFailed(f"run stopped: {reason}{kept}{again}")
