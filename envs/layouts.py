@@ -25,7 +25,24 @@ Pose = tuple[float, float, float]
 
 @dataclass(frozen=True)
 class Layout:
-    """A room description independent of any physics engine."""
+    """A room description independent of any physics engine.
+
+    Attributes
+    ----------
+    name : str
+        Layout name (also seeds the textures, see ``texture_name``).
+    bounds : tuple of float
+        ``(xmin, ymin, xmax, ymax)`` of the floor, metres, world frame.
+    shapes : tuple of Shape
+        Walls and furniture (``Box`` and ``Cylinder``), each with a unique name.
+    starts : tuple of (float, float, float)
+        Start poses ``(x, y, yaw)`` in metres and radians; seed ``k`` of a study starts at
+        ``starts[k]`` while there are enough (``cogmap.starts.seed_start``).
+    paper_area : float or None
+        The free area (m2) the paper reports for this space, when it is one of the paper's.
+    texture_seed : int or None
+        Seeds the textures together with the name; None: the name alone.
+    """
 
     name: str
     bounds: tuple[float, float, float, float]
@@ -40,6 +57,23 @@ class Layout:
         return self.name if self.texture_seed is None else f"{self.name}#{self.texture_seed}"
 
     def shape(self, name: str) -> Shape:
+        """The shape called ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A shape's name.
+
+        Returns
+        -------
+        Shape
+            That shape.
+
+        Raises
+        ------
+        KeyError
+            When the layout has no shape of that name.
+        """
         for s in self.shapes:
             if s.name == name:
                 return s
@@ -47,10 +81,26 @@ class Layout:
 
     @property
     def names(self) -> list[str]:
+        """Names of the shapes, in order."""
         return [s.name for s in self.shapes]
 
     def with_moved(self, name: str, xy, yaw: float | None = None) -> Layout:
-        """A copy with shape `name` moved to `xy` (and `yaw` for boxes)."""
+        """A copy with shape ``name`` moved to ``xy`` (and turned to ``yaw`` for boxes).
+
+        Parameters
+        ----------
+        name : str
+            The shape to move.
+        xy : array_like
+            New centre ``(x, y)``, metres.
+        yaw : float, optional
+            New heading of a box, radians (ignored for cylinders).
+
+        Returns
+        -------
+        Layout
+            The moved copy (this layout is unchanged).
+        """
         old = self.shape(name)
         kw = {"x": float(xy[0]), "y": float(xy[1])}
         if yaw is not None and isinstance(old, Box):
@@ -393,7 +443,27 @@ LAYOUTS: dict[str, Callable[..., Layout]] = {
 
 
 def make_layout(name: str, seed: int = 0, **kwargs) -> Layout:
-    """Build a layout by name (see `LAYOUTS`)."""
+    """Build a layout by name (see ``LAYOUTS``).
+
+    Parameters
+    ----------
+    name : str
+        Layout name, e.g. ``"house"`` or ``"building"``.
+    seed : int, optional
+        Seed of the layout's random parts (furniture jitter, procedural plans).
+    **kwargs
+        Passed to the layout's builder (e.g. ``kind`` for ``"building"``).
+
+    Returns
+    -------
+    Layout
+        The layout.
+
+    Raises
+    ------
+    KeyError
+        When no layout has that name (the message lists the known ones).
+    """
     try:
         return LAYOUTS[name](seed, **kwargs)
     except KeyError:
