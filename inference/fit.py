@@ -48,19 +48,20 @@ class FitResult(NamedTuple):
 
 
 def _kl_dirichlet(a: np.ndarray, a0: np.ndarray) -> np.ndarray:
-    """KL(Dir(a) || Dir(a0)) summed over columns (axis -2, the outcome axis is -2 of a batch
-    ``(..., outcomes, columns)``); returns one value per leading index."""
+    """``KL(Dir(a) || Dir(a0))`` for a batch of counts ``(R, ..., outcomes, columns)``, summed
+    over the columns of each restart: shape ``(R,)``."""
     s, s0 = a.sum(axis=-2), a0.sum(axis=-2)
     kl = (gammaln(s) - gammaln(s0) - np.sum(gammaln(a) - gammaln(a0), axis=-2)
           + np.sum((a - a0) * (digamma(a) - digamma(s)[..., None, :]), axis=-2))
-    return kl.reshape(kl.shape[0], -1).sum(axis=1) if kl.ndim > 1 else kl.sum()
+    return kl.reshape(kl.shape[0], -1).sum(axis=1)
 
 
 def _elog(counts: np.ndarray, axis: int = 0) -> np.ndarray:
     return digamma(counts) - digamma(counts.sum(axis=axis, keepdims=True))
 
 
-_BLOCK = 512  # restarts are smoothed together in groups of at most this many states in all
+_BLOCK = 128  # restarts are smoothed together in groups of at most this many states in all (past
+# that the wasted products of the block-diagonal matrix cost more than the steps it saves)
 
 
 def _forward_backward_batch(lik: np.ndarray, trans: np.ndarray, actions: np.ndarray, d: np.ndarray):
@@ -140,7 +141,7 @@ def _check_sequences(model, sequences) -> list[tuple[np.ndarray, np.ndarray]]:
 
 def fit(model, sequences: Sequence, *, learn_A: bool = True, learn_B: bool = True, iterations: int = 20,
         tol: float = 1e-6, init_counts: float = 0.0, seed: int | None = None, restarts: int = 1,
-        anneal_iterations: int = 0, anneal_from: float = 0.5) -> FitResult:
+        anneal_iterations: int = 0, anneal_from: float = 0.7) -> FitResult:
     """Fit the Dirichlet counts of ``model`` (one factor, dense) to ``sequences``, each a pair
     ``(observations, actions)`` with ``observations[t]`` one outcome index per modality and
     ``actions[t]`` the control between steps ``t`` and ``t + 1``. The model's current counts
@@ -193,8 +194,8 @@ def fit(model, sequences: Sequence, *, learn_A: bool = True, learn_B: bool = Tru
         for x in a:
             if x is not None:
                 x[r] += rng.exponential(init_counts, x.shape[1:])
-        if b is not None:
-            b[r] += rng.exponential(init_counts, b.shape[1:])
+        if b is not None:  # drawn in the model's (next, prev, control) layout
+            b[r] += np.moveaxis(rng.exponential(init_counts, model.live_pB(0).shape), 2, 0)
     fixed_logA = [None if learn_A else floor_log(model.live_A(m), TINY_FLOOR) for m in range(M)]
     fixed_B = None if learn_B else np.moveaxis(model.live_B(0), 2, 0)[None]
     d0 = model.live_D(0)

@@ -138,7 +138,7 @@ def test_restarts_and_annealing_reach_the_true_models_surprise_on_an_aliased_roo
     assert surprise_bits(plain, *test) > 1.1 * reference
     model, _, _ = _room(learn=True, conc=1 / n, learn_A=False)
     res = fit(model, [train], learn_A=False, iterations=100, init_counts=1.0, seed=0, restarts=3,
-              anneal_iterations=20, anneal_from=0.5)
+              anneal_iterations=20)
     assert len(res.histories) == 3
     for h in res.histories:  # monotone within every restart, from the first untempered iteration
         assert len(h) >= 2
