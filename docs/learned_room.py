@@ -18,7 +18,8 @@ import numpy as np
 
 from cogmap.genmodel import Factor, Modality, ModelSpec, compile
 from cogmap.genmodel.demo_models import ROOM_MOVES, aliased_room
-from cogmap.inference.fit import _forward_backward, fit, surprise_bits
+from cogmap.inference.exact import exact
+from cogmap.inference.fit import fit, surprise_bits
 
 OUT = Path(__file__).resolve().parent / "img" / "learning"
 SIDE, VIEWS, STEPS = 5, 8, 10000
@@ -47,12 +48,12 @@ def room(A, B, conc=None):
     return compile(spec)
 
 
-def place_of_states(model, A, obs, acts, places):
-    """For each learned state, the true place it stands for most often on the walk."""
+def place_of_states(model, obs, acts, places):
+    """For each learned state, the true place it stands for most often on the walk (exact
+    smoothing under the learned model)."""
     n = model.num_states[0]
-    B = model.live_B(0)
-    gamma, _, _ = _forward_backward(A[np.asarray(obs)[:, 0]], [B[:, :, u] for u in range(B.shape[2])],
-                                    np.asarray(acts), np.full(n, 1 / n))
+    _, info = exact(model, [model.live_D(0)], obs, [(u,) for u in acts])
+    gamma = np.array([q[0] for q in info.history])
     mass = np.zeros((n, n))  # (place, state)
     np.add.at(mass, places, gamma)
     return mass.argmax(axis=0)
@@ -101,7 +102,7 @@ def main() -> None:
         model = room(A, B, conc=1 / n)
         res = fit(model, [(obs, acts)], learn_A=False, iterations=200, init_counts=1.0, seed=0, **kw)
         bits = surprise_bits(model, held_obs, held_acts)
-        where = place_of_states(model, A, obs, acts, places)
+        where = place_of_states(model, obs, acts, places)
         wrong = draw(ax, model, where, B, label, "")
         ax.set_title(f"{name}: F = {res.free_energy[-1]:.0f} nats, {bits:.3f} bits/step held out\n"
                      f"(true model {true_bits:.3f}); moves wrong: {wrong} of {4 * n}, "
