@@ -149,6 +149,58 @@ ALL_TERMS: dict[str, Term] = {
 #: terms whose value is information: gained once, so not counted again on a revisit (MCTS)
 EPISTEMIC = (state_info_gain, param_info_gain, a_novelty, b_novelty, sensed_info_gain)
 
+# -- user terms ------------------------------------------------------------------------------
+_USER_TERMS: dict[str, Term] = {}
+_USER_EPISTEMIC: dict[str, Term] = {}
+
+
+def register_term(name: str, term: Term, overwrite: bool = False, *, epistemic: bool = False) -> Term:
+    """Make ``term`` usable by name in :func:`objective` (and so in every planner).
+
+    ``term(ctx) -> (K,)`` follows the contract of the built-in terms (module docstring): higher
+    is better, the objective subtracts ``weight * term(ctx)`` from ``G``. ``epistemic=True``
+    marks its value as information, counted once per imagined path when MCTS runs with
+    ``count_information_once``. Raises ValueError for an empty name, a built-in name
+    (:data:`ALL_TERMS`) or a name already registered (unless ``overwrite``), TypeError for a
+    non-callable ``term``. Returns ``term``.
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"register_term: name must be a non-empty string, got {name!r}")
+    if not callable(term):
+        raise TypeError(f"register_term('{name}'): expected a callable term(ctx) -> (K,), got {type(term).__name__}")
+    if name in ALL_TERMS:
+        raise ValueError(f"register_term: '{name}' is a built-in EFE term; choose another name")
+    if name in _USER_TERMS and not overwrite and _USER_TERMS[name] is not term:
+        raise ValueError(f"register_term: a term named '{name}' exists (pass overwrite=True)")
+    _USER_TERMS[name] = term
+    _USER_EPISTEMIC.pop(name, None)
+    if epistemic:
+        _USER_EPISTEMIC[name] = term
+    return term
+
+
+def unregister_term(name: str) -> None:
+    """Remove a registered term (KeyError listing the registered ones for an unknown name)."""
+    if name not in _USER_TERMS:
+        raise KeyError(f"no registered EFE term named {name!r} (registered: {sorted(_USER_TERMS)})")
+    del _USER_TERMS[name]
+    _USER_EPISTEMIC.pop(name, None)
+
+
+def available_terms() -> tuple[str, ...]:
+    """Names :func:`objective` accepts: the built-in terms and the registered ones."""
+    return tuple(sorted({*ALL_TERMS, *_USER_TERMS}))
+
+
+def is_builtin(term: Term) -> bool:
+    """Whether ``term`` is one of this module's terms (the planners prepare exactly what those
+    read; a user term may read any attribute of the step context)."""
+    return any(term is t for t in ALL_TERMS.values())
+
+
+def is_epistemic(term: Term) -> bool:
+    return any(term is t for t in EPISTEMIC) or any(term is t for t in _USER_EPISTEMIC.values())
+
 
 # -- combinator ------------------------------------------------------------------------------
 @dataclass(frozen=True)
@@ -173,7 +225,7 @@ class Objective:
             if w != 0.0:
                 v = w * term(ctx)
                 g -= v
-                if term not in EPISTEMIC:
+                if not is_epistemic(term):
                     g_known -= v
         return g, g_known
 
@@ -190,14 +242,18 @@ class Objective:
 
 
 def objective(terms: Sequence[tuple[Term | str, float]] | dict) -> Objective:
-    """Build an objective from ``[(term, weight), ...]`` (terms as functions or names)."""
+    """Build an objective from ``[(term, weight), ...]`` or ``{term: weight}`` (terms as functions
+    or names: the built-in ones and those added with :func:`register_term`)."""
     items = terms.items() if isinstance(terms, dict) else terms
     out = []
     for t, w in items:
         if isinstance(t, str):
-            if t not in ALL_TERMS:
-                raise KeyError(f"unknown EFE term '{t}' (known: {sorted(ALL_TERMS)})")
-            t = ALL_TERMS[t]
+            if t in ALL_TERMS:
+                t = ALL_TERMS[t]
+            elif t in _USER_TERMS:
+                t = _USER_TERMS[t]
+            else:
+                raise KeyError(f"unknown EFE term '{t}' (known: {list(available_terms())})")
         if not callable(t):
             raise TypeError(f"EFE term {t!r} is not callable")
         out.append((t, float(w)))
