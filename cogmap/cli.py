@@ -8,6 +8,7 @@ Every error ends the command with one line on stderr naming the problem and exit
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
@@ -83,6 +84,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="cogmap", description="Active-inference navigation toolkit")
     p.add_argument("--version", action="version", version=f"cogmap {__version__}")
     p.add_argument("--debug", action="store_true", help="show the full traceback of an error")
+    p.add_argument("--plugin", action="append", default=[], metavar="MODULE",
+                   help="import MODULE first (repeatable): its registrations (layouts, schemes, planners, "
+                        "EFE terms, encoders) are then known by name")
     sub = p.add_subparsers(dest="command", required=True)
 
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
@@ -171,6 +175,8 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     prog = f"cogmap {args.command}" + (f" {args.drone_command}" if args.command == "drone" else "")
     try:
+        for module in args.plugin:
+            importlib.import_module(module)
         return args.func(args)
     except KeyboardInterrupt:
         if args.debug:

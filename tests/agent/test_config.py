@@ -25,6 +25,8 @@ def _other(value):
         return 0.123
     if isinstance(value, tuple):
         return tuple(_other(v) for v in value)
+    if isinstance(value, str):
+        return value + "_other"
     raise TypeError(value)
 
 
