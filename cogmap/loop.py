@@ -87,7 +87,8 @@ def init(
     """A fresh agent on ``model``: the prior is ``D``. ``objective`` is an
     :class:`~cogmap.planning.efe.Objective` or a name of ``planning.decide.MODES``: "pymdp" (utility
     + state information gain, pymdp's default ``neg_efe``; the default), "explore", "goal", "full",
-    "sensed"; ``scheme_options``
+    "sensed"; ``scheme`` and ``planner`` are names in the inference and planner registries
+    (``cogmap.inference.register``, ``cogmap.planning.register_planner``); ``scheme_options``
     go to the inference scheme (e.g. ``num_iter=16``)."""
     if not isinstance(model, Model):
         raise TypeError(f"init needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")

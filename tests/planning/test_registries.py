@@ -193,3 +193,30 @@ def test_builtin_planners_by_name_match_the_direct_calls():
     assert plan.action == tuple(int(x) for x in a)
     np.testing.assert_allclose(plan.q_pi, q_pi)
     np.testing.assert_allclose(plan.G, G)
+
+
+def test_a_user_term_indexing_by_U_agrees_between_the_local_and_dense_contexts(term_name):
+    """The Extending page's contract: in a LocalStep ``qs[0]`` covers the states ``ctx.U``; a term
+    that indexes its per-state array with ``ctx.U`` there gives the DenseStep's values."""
+    from cogmap.planning.context import LocalStep
+    from cogmap.planning.testing import graph_arrays
+
+    from .planning_builders import chain
+
+    G, poses = chain(8)
+    arrays = graph_arrays(G, poses, p_move=0.8)
+    bonus = 1.0 / np.sqrt(1.0 + np.arange(8.0) ** 2)
+
+    def by_state(ctx):
+        return ctx.qs[0] @ (bonus[ctx.U] if isinstance(ctx, LocalStep) else bonus)
+
+    register_term("by_state", by_state)
+    term_name.append("by_state")
+    obj = objective({"by_state": 1.0})
+    prior = np.zeros(8)
+    prior[[3, 4]] = [0.3, 0.7]
+    actions = np.arange(arrays.num_controls[0])
+    local = LocalStep(prepare(arrays, local=True), np.array([3, 4]), np.array([0.3, 0.7]), actions)
+    dense = DenseStep(prepare(arrays, local=False), [np.tile(prior, (actions.size, 1))], actions[:, None])
+    np.testing.assert_allclose(obj(local), obj(dense), atol=1e-12)
+    assert np.ptp(obj(dense)) > 1e-3  # the moves differ, so the check has teeth
