@@ -195,11 +195,13 @@ def available_terms() -> tuple[str, ...]:
 def is_builtin(term: Term) -> bool:
     """Whether ``term`` is one of this module's terms (the planners prepare exactly what those
     read; a user term may read any attribute of the step context)."""
-    return any(term is t for t in ALL_TERMS.values())
+    return term in ALL_TERMS.values()
 
 
 def is_epistemic(term: Term) -> bool:
-    return any(term is t for t in EPISTEMIC) or any(term is t for t in _USER_EPISTEMIC.values())
+    """Whether ``term``'s value is information (built-in epistemic terms, or registered with
+    ``epistemic=True``): :meth:`Objective.split` leaves it out of a revisited step's value."""
+    return term in EPISTEMIC or term in _USER_EPISTEMIC.values()
 
 
 # -- combinator ------------------------------------------------------------------------------
