@@ -18,6 +18,8 @@ PAGES = ["tutorial-generative-model.md", "quickstart.md", "tutorial-aimapp.md", 
          "tutorial-drone.md", "tutorial-dvbf.md"]
 
 
+# docs/extending/ stays out of PAGES (which run in this process): those pages register things in
+# process-wide registries, so test_extending_page_runs gives each its own interpreter
 EXTENDING = sorted(p.relative_to(DOCS).as_posix() for p in (DOCS / "extending").glob("*.md") if p.name != "index.md")
 
 
