@@ -57,13 +57,31 @@ def register_layout(name: str, factory: Callable[..., Layout], *, env_id: str | 
                     overwrite: bool = False, max_episode_steps: int = MAX_STEPS) -> None:
     """Register a room under ``name`` (and optionally the Gymnasium id ``env_id``).
 
-    ``factory(seed: int = 0, **kwargs) -> Layout`` builds the room (``seed`` varies what the
-    room randomises, if anything); it is called once here with ``seed=0`` so a broken factory
-    fails now, with its name. With ``env_id`` the id is registered with Gymnasium on
-    :class:`~cogmap.envs.gym_env.NavEnv` and ``cogmap explore --env`` accepts it as well.
-    Raises ValueError for an empty name, a built-in layout name, a name or id already taken
-    (unless ``overwrite``) or a factory that does not return a :class:`Layout`; TypeError for
-    a non-callable factory.
+    ``make_layout(name)``, ``NavEnv(layout=name)``, ``cogmap.explore.explore(name)`` and
+    ``cogmap explore --env NAME`` then find it; with ``env_id`` also ``gymnasium.make(env_id)``
+    and ``--env ENV_ID``.
+
+    Parameters
+    ----------
+    name : str
+        The room's name.
+    factory : callable
+        ``factory(seed: int = 0, **kwargs) -> Layout``; ``seed`` varies what the room
+        randomises, if anything. Called once here with ``seed=0`` so a broken factory fails now.
+    env_id : str, optional
+        A Gymnasium id to register on :class:`~cogmap.envs.gym_env.NavEnv`.
+    overwrite : bool
+        Replace a room (and id) registered earlier under the same name.
+    max_episode_steps : int
+        Episode length of the Gymnasium id (default 500, as the built-in rooms).
+
+    Raises
+    ------
+    ValueError
+        Empty name, a built-in layout name or id, a name or id already taken without
+        ``overwrite``, or a factory that does not return a :class:`Layout`.
+    TypeError
+        ``factory`` is not callable.
     """
     if not isinstance(name, str) or not name:
         raise ValueError(f"register_layout: name must be a non-empty string, got {name!r}")
@@ -94,8 +112,20 @@ def register_layout(name: str, factory: Callable[..., Layout], *, env_id: str | 
 
 
 def unregister_layout(name: str) -> None:
-    """Remove a registered room and its Gymnasium ids (KeyError for an unknown name, ValueError
-    for a built-in one)."""
+    """Remove a registered room and its Gymnasium ids.
+
+    Parameters
+    ----------
+    name : str
+        A name given to :func:`register_layout`.
+
+    Raises
+    ------
+    KeyError
+        No registered room has that name (the message lists the registered ones).
+    ValueError
+        ``name`` is a built-in layout.
+    """
     if name in _BUILTIN_LAYOUTS:
         raise ValueError(f"'{name}' is a built-in layout and cannot be removed")
     if name not in LAYOUTS:

@@ -157,12 +157,31 @@ _USER_EPISTEMIC: dict[str, Term] = {}
 def register_term(name: str, term: Term, overwrite: bool = False, *, epistemic: bool = False) -> Term:
     """Make ``term`` usable by name in :func:`objective` (and so in every planner).
 
-    ``term(ctx) -> (K,)`` follows the contract of the built-in terms (module docstring): higher
-    is better, the objective subtracts ``weight * term(ctx)`` from ``G``. ``epistemic=True``
-    marks its value as information, counted once per imagined path when MCTS runs with
-    ``count_information_once``. Raises ValueError for an empty name, a built-in name
-    (:data:`ALL_TERMS`) or a name already registered (unless ``overwrite``), TypeError for a
-    non-callable ``term``. Returns ``term``.
+    Parameters
+    ----------
+    name : str
+        The name ``objective({name: weight})`` will accept.
+    term : callable
+        ``term(ctx) -> (K,)`` with the contract of the built-in terms (module docstring):
+        higher is better, the objective subtracts ``weight * term(ctx)`` from ``G``.
+    overwrite : bool
+        Replace a term registered under ``name`` (built-in terms cannot be replaced).
+    epistemic : bool
+        The value is information: counted once per imagined path when MCTS runs with
+        ``count_information_once`` (see :meth:`Objective.split`).
+
+    Returns
+    -------
+    callable
+        ``term``.
+
+    Raises
+    ------
+    ValueError
+        Empty name, a built-in name (:data:`ALL_TERMS`), or a name already registered without
+        ``overwrite``.
+    TypeError
+        ``term`` is not callable.
     """
     if not isinstance(name, str) or not name:
         raise ValueError(f"register_term: name must be a non-empty string, got {name!r}")
@@ -180,7 +199,18 @@ def register_term(name: str, term: Term, overwrite: bool = False, *, epistemic: 
 
 
 def unregister_term(name: str) -> None:
-    """Remove a registered term (KeyError listing the registered ones for an unknown name)."""
+    """Remove a term added with :func:`register_term`.
+
+    Parameters
+    ----------
+    name : str
+        The registered name.
+
+    Raises
+    ------
+    KeyError
+        No registered term has that name (the message lists the registered ones).
+    """
     if name not in _USER_TERMS:
         raise KeyError(f"no registered EFE term named {name!r} (registered: {sorted(_USER_TERMS)})")
     del _USER_TERMS[name]
@@ -188,19 +218,49 @@ def unregister_term(name: str) -> None:
 
 
 def available_terms() -> tuple[str, ...]:
-    """Names :func:`objective` accepts: the built-in terms and the registered ones."""
+    """Names :func:`objective` accepts.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names of the built-in and the registered terms.
+    """
     return tuple(sorted({*ALL_TERMS, *_USER_TERMS}))
 
 
 def is_builtin(term: Term) -> bool:
-    """Whether ``term`` is one of this module's terms (the planners prepare exactly what those
-    read; a user term may read any attribute of the step context)."""
+    """Whether ``term`` is one of this module's terms.
+
+    The planners prepare exactly what the built-in terms read; a user term may read any
+    attribute of the step context, so with one in an objective everything is prepared.
+
+    Parameters
+    ----------
+    term : callable
+        A term function.
+
+    Returns
+    -------
+    bool
+        True for a term of :data:`ALL_TERMS`.
+    """
     return term in ALL_TERMS.values()
 
 
 def is_epistemic(term: Term) -> bool:
-    """Whether ``term``'s value is information (built-in epistemic terms, or registered with
-    ``epistemic=True``): :meth:`Objective.split` leaves it out of a revisited step's value."""
+    """Whether ``term``'s value is information.
+
+    Parameters
+    ----------
+    term : callable
+        A term function.
+
+    Returns
+    -------
+    bool
+        True for the built-in epistemic terms (:data:`EPISTEMIC`) and terms registered with
+        ``epistemic=True``; :meth:`Objective.split` leaves those out of a revisited step's value.
+    """
     return term in EPISTEMIC or term in _USER_EPISTEMIC.values()
 
 

@@ -30,7 +30,21 @@ from .mcts import MCTSConfig
 
 
 class PlanSettings(NamedTuple):
-    """What the loop passes to every planner (a planner reads only what it needs)."""
+    """What the loop passes to every planner (a planner reads only what it needs).
+
+    Attributes
+    ----------
+    policy_len : int
+        Steps per policy (enumeration).
+    gamma : float
+        Policy precision: ``q(pi) = softmax(-gamma G)`` (Eq. 4 of the AIMAPP paper).
+    rng : numpy.random.Generator or None
+        The loop's generator; use it for any randomness so runs are reproducible.
+    sample : bool
+        Sample the action from ``q(pi)``; False takes its mode.
+    mcts : MCTSConfig or None
+        Depth and simulations for tree search (None: the defaults).
+    """
 
     policy_len: int = 1  # steps per policy (enumeration)
     gamma: float = 16.0  # policy precision, q(pi) = softmax(-gamma G) (Eq. 4)
@@ -40,7 +54,19 @@ class PlanSettings(NamedTuple):
 
 
 class Plan(NamedTuple):
-    """A planner's answer."""
+    """A planner's answer.
+
+    Attributes
+    ----------
+    action : tuple of int
+        One control per factor, to apply now.
+    G : numpy.ndarray
+        Expected free energy (nats) of what was compared: per policy, per root action, ...
+    q_pi : numpy.ndarray or None
+        Posterior over those policies, if the planner has one.
+    policies : numpy.ndarray or None
+        ``(P, T, F)`` policies of ``q_pi`` and ``G`` (enumeration).
+    """
 
     action: tuple  # one integer control per factor, to apply now
     G: np.ndarray  # expected free energy of what was compared (per policy, per root action, ...)
@@ -56,8 +82,28 @@ _PLANNERS: dict[str, Planner] = {}
 def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = False):
     """Register planner ``fn`` under ``name``; usable as a decorator (``@register_planner("mine")``).
 
-    Raises ValueError for an empty name or a name already taken (unless ``overwrite``; the
-    built-in ``"enumerate"`` and ``"mcts"`` cannot be replaced), TypeError for a non-callable.
+    Parameters
+    ----------
+    name : str
+        The name ``cogmap.loop.init(planner=name)`` will use.
+    fn : callable, optional
+        ``fn(model, qs, objective, settings) -> Plan`` (module docstring). Omitted: returns a
+        decorator.
+    overwrite : bool
+        Replace a planner registered under ``name`` (the built-in ``"enumerate"`` and
+        ``"mcts"`` cannot be replaced).
+
+    Returns
+    -------
+    callable
+        ``fn`` (or the decorator registering it).
+
+    Raises
+    ------
+    ValueError
+        Empty name, a built-in name, or a name already taken without ``overwrite``.
+    TypeError
+        ``fn`` is not callable.
     """
     if not isinstance(name, str) or not name:
         raise ValueError(f"register_planner: name must be a non-empty string, got {name!r}")
@@ -76,7 +122,20 @@ def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = 
 
 
 def unregister_planner(name: str) -> None:
-    """Remove a user planner (KeyError for an unknown name, ValueError for a built-in one)."""
+    """Remove a registered planner.
+
+    Parameters
+    ----------
+    name : str
+        A name given to :func:`register_planner`.
+
+    Raises
+    ------
+    KeyError
+        No planner has that name (the message lists the registered ones).
+    ValueError
+        ``name`` is a built-in planner.
+    """
     if name in BUILTIN:
         raise ValueError(f"'{name}' is a built-in planner and cannot be removed")
     if name not in _PLANNERS:
@@ -85,7 +144,23 @@ def unregister_planner(name: str) -> None:
 
 
 def get_planner(name: str) -> Planner:
-    """The planner registered as ``name``; KeyError listing the known names otherwise."""
+    """The planner registered as ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A built-in (``"enumerate"``, ``"mcts"``) or registered planner name.
+
+    Returns
+    -------
+    callable
+        ``planner(model, qs, objective, settings) -> Plan``.
+
+    Raises
+    ------
+    KeyError
+        Unknown name; the message lists the registered ones.
+    """
     try:
         return _PLANNERS[name]
     except (KeyError, TypeError):
@@ -93,12 +168,36 @@ def get_planner(name: str) -> Planner:
 
 
 def available_planners() -> tuple[str, ...]:
+    """Names of every planner the loop can use.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names, the built-in ones included.
+    """
     return tuple(sorted(_PLANNERS))
 
 
 # -- the two built-in planners -----------------------------------------------------------------
 def enumerate_planner(model, qs, objective, settings: PlanSettings) -> Plan:
-    """Every policy of ``settings.policy_len`` steps, ``q(pi) = softmax(-gamma G)`` (Eq. 4)."""
+    """Every policy of ``settings.policy_len`` steps, ``q(pi) = softmax(-gamma G)`` (Eq. 4).
+
+    Parameters
+    ----------
+    model : Model or PlanningArrays
+        The model to plan with.
+    qs : list of numpy.ndarray
+        Current belief, one ``(n_f,)`` array per factor.
+    objective : Objective
+        Per-step expected free energy.
+    settings : PlanSettings
+        Policy length, precision, RNG and whether to sample.
+
+    Returns
+    -------
+    Plan
+        First action of the chosen policy, ``G`` and ``q(pi)`` per policy, the policies.
+    """
     from .policies import infer_policies
 
     rng = settings.rng if settings.sample else None
@@ -108,7 +207,25 @@ def enumerate_planner(model, qs, objective, settings: PlanSettings) -> Plan:
 
 
 def mcts_planner(model, qs, objective, settings: PlanSettings) -> Plan:
-    """MCTS over EFE (Appendix A.3); the controls of factors it does not move are 0."""
+    """MCTS over EFE (Appendix A.3 of the AIMAPP paper) through :func:`~.decide.decide`.
+
+    Parameters
+    ----------
+    model : Model or PlanningArrays
+        The model to plan with.
+    qs : list of numpy.ndarray
+        Current belief, one ``(n_f,)`` array per factor.
+    objective : Objective
+        Per-step expected free energy.
+    settings : PlanSettings
+        ``settings.mcts`` (default: ``MCTSConfig(gamma=settings.gamma)``) and the RNG.
+
+    Returns
+    -------
+    Plan
+        The chosen control per factor (0 for factors the search does not move) and the
+        backed-up EFE per root action; no ``q_pi``.
+    """
     from .decide import decide
 
     mcfg = settings.mcts or MCTSConfig(gamma=settings.gamma)

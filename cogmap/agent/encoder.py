@@ -251,7 +251,18 @@ class SSIMEncoder:
 
 # -- encoders by name ----------------------------------------------------------------------------
 def _ssim_encoder(config) -> SSIMEncoder:
-    """The paper's encoder (section 3.1) with the configured threshold (Table 6: 0.65)."""
+    """The paper's encoder (section 3.1) with the configured threshold (Table 6: 0.65).
+
+    Parameters
+    ----------
+    config : AgentConfig
+        Reads ``ssim_threshold``.
+
+    Returns
+    -------
+    SSIMEncoder
+        A new, empty encoder.
+    """
     return SSIMEncoder(config.ssim_threshold)
 
 
@@ -260,9 +271,30 @@ _ENCODERS: dict[str, Callable] = dict(_BUILTIN_ENCODERS)
 
 
 def register_encoder(name: str, factory: Callable | None = None, *, overwrite: bool = False):
-    """Register ``factory(config: AgentConfig) -> Encoder`` under ``name`` (usable as a
-    decorator). ``AgentConfig(encoder=name)`` then selects it. Raises ValueError for an empty or
-    built-in name or a name already taken (unless ``overwrite``), TypeError for a non-callable."""
+    """Register an encoder factory under ``name``; ``AgentConfig(encoder=name)`` then selects it.
+
+    Parameters
+    ----------
+    name : str
+        The name for ``AgentConfig.encoder``.
+    factory : callable, optional
+        ``factory(config: AgentConfig) -> Encoder``, called once per agent. Omitted: returns a
+        decorator.
+    overwrite : bool
+        Replace a factory registered under ``name`` (the built-in ``"ssim"`` cannot be replaced).
+
+    Returns
+    -------
+    callable
+        ``factory`` (or the decorator registering it).
+
+    Raises
+    ------
+    ValueError
+        Empty or built-in name, or a name already taken without ``overwrite``.
+    TypeError
+        ``factory`` is not callable, or is an encoder itself rather than a factory.
+    """
     if not isinstance(name, str) or not name:
         raise ValueError(f"register_encoder: name must be a non-empty string, got {name!r}")
 
@@ -282,7 +314,20 @@ def register_encoder(name: str, factory: Callable | None = None, *, overwrite: b
 
 
 def unregister_encoder(name: str) -> None:
-    """Remove a registered encoder (KeyError for an unknown name, ValueError for a built-in one)."""
+    """Remove a registered encoder factory.
+
+    Parameters
+    ----------
+    name : str
+        A name given to :func:`register_encoder`.
+
+    Raises
+    ------
+    KeyError
+        No encoder has that name (the message lists the registered ones).
+    ValueError
+        ``name`` is a built-in encoder.
+    """
     if name in _BUILTIN_ENCODERS:
         raise ValueError(f"'{name}' is a built-in encoder and cannot be removed")
     if name not in _ENCODERS:
@@ -291,12 +336,38 @@ def unregister_encoder(name: str) -> None:
 
 
 def available_encoders() -> tuple[str, ...]:
+    """Names ``AgentConfig.encoder`` accepts.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names, the built-in ``"ssim"`` included.
+    """
     return tuple(sorted(_ENCODERS))
 
 
 def make_encoder(name: str, config) -> Encoder:
-    """Build the encoder registered as ``name`` for ``config`` (an ``AgentConfig``) and check it
-    follows :class:`Encoder`; KeyError listing the known names for an unknown one."""
+    """Build the encoder registered as ``name`` and check it follows :class:`Encoder`.
+
+    Parameters
+    ----------
+    name : str
+        A registered encoder name (``AgentConfig.encoder``).
+    config : AgentConfig
+        Passed to the factory.
+
+    Returns
+    -------
+    Encoder
+        A new encoder.
+
+    Raises
+    ------
+    KeyError
+        Unknown name; the message lists the registered ones.
+    TypeError
+        The factory's result lacks a member of the :class:`Encoder` protocol.
+    """
     try:
         factory = _ENCODERS[name]
     except (KeyError, TypeError):
