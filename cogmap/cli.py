@@ -18,13 +18,16 @@ from .argtypes import OneLineParser, nonnegative_int, positive_int
 
 
 def _explore(args) -> int:
+    from dataclasses import replace
+
     from .envs import OdometryNoise
-    from .explore import explore
+    from .explore import default_config, explore
 
     out = Path(args.out)
     noise = OdometryNoise(slip=args.slip, heading_bias=args.heading_bias)
+    config = replace(default_config(args.env), encoder=args.encoder)
     metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
-                      patience=args.patience, noise=noise)
+                      patience=args.patience, noise=noise, config=config)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
     return 0
@@ -101,6 +104,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "per metre)")
     e.add_argument("--heading-bias", type=float, default=0.0,
                    help="odometry drift: yaw error in rad per metre travelled (default: 0)")
+    e.add_argument("--encoder", default="ssim", help="observation encoder by name (default: ssim, the paper's; "
+                   "others from --plugin modules)")
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.set_defaults(func=_explore)

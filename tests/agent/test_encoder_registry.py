@@ -69,3 +69,31 @@ def test_the_agent_builds_and_uses_the_configured_encoder(registered):
     run(world, agent, 8)
     # the observation ids are the encoder's: one per 2 m cell visited
     assert agent.model.num_obs[0] == len(agent.encoder.ids) >= 2
+
+
+def test_cli_explore_uses_an_encoder_from_a_plugin(tmp_path, monkeypatch, capsys, registered):
+    import json
+
+    from cogmap.cli import main
+
+    (tmp_path / "strict_encoder_plugin.py").write_text(
+        "from cogmap.agent.encoder import SSIMEncoder, register_encoder\n"
+        "register_encoder('strict_ssim', lambda config: SSIMEncoder(0.999))\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    registered.append("strict_ssim")
+    out = tmp_path / "run"
+    code = main(["--plugin", "strict_encoder_plugin", "explore", "--encoder", "strict_ssim", "--steps", "3",
+                 "--patience", "0", "--out", str(out), "--quiet"])
+    assert code == 0, capsys.readouterr().err
+    assert json.loads((out / "run.json").read_text())["config"]["encoder"] == "strict_ssim"
+    metrics = json.loads((out / "metrics.json").read_text())
+    # with a 0.999 threshold no two panoramas from different places match: one id per decision
+    assert metrics["num_observations"] == 3 == len(list((out / "observations").glob("*.png")))
+
+
+def test_cli_explore_with_an_unknown_encoder_is_a_one_line_error(capsys, tmp_path):
+    from cogmap.cli import main
+
+    assert main(["explore", "--encoder", "nope", "--steps", "1", "--out", str(tmp_path / "run"), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown encoder 'nope'" in err and "ssim" in err
