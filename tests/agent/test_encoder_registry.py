@@ -89,6 +89,11 @@ def test_cli_explore_uses_an_encoder_from_a_plugin(tmp_path, monkeypatch, capsys
     metrics = json.loads((out / "metrics.json").read_text())
     # with a 0.999 threshold no two panoramas from different places match: one id per decision
     assert metrics["num_observations"] == 3 == len(list((out / "observations").glob("*.png")))
+    # a goal run rebuilds the run's encoder by name and restores its observations
+    from cogmap.goal import load_agent
+
+    agent, _ = load_agent(out)
+    assert agent.encoder.threshold == 0.999 and len(agent.encoder.images) == 3
 
 
 def test_cli_explore_with_an_unknown_encoder_is_a_one_line_error(capsys, tmp_path):
