@@ -79,7 +79,12 @@ class AgentConfig:
         return self.pose_sigma if self.pose_sigma is not None else self.influence_radius / 3
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        if d["encoder"] == "ssim":
+            # the paper's encoder is left implicit (from_dict restores it), so the manifests and
+            # study run keys of runs made before encoders were chosen by name stay the same
+            del d["encoder"]
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> AgentConfig:

@@ -91,3 +91,10 @@ def test_cell_encoder_match_stores_nothing():
     assert enc((0.2, 0.2)) == (0, True)
     assert enc.match((0.7, 0.4)) == (0, 1.0) and enc.match((1.5, 0.2)) == (-1, 0.0)
     assert len(enc.ids) == 1
+
+
+def test_the_default_encoder_is_implicit_in_saved_configs():
+    """Run keys of the studies digest the saved config: the paper's encoder adds no key to it."""
+    assert "encoder" not in AgentConfig().to_dict()
+    assert AgentConfig.from_dict(AgentConfig().to_dict()).encoder == "ssim"
+    assert AgentConfig(encoder="mine").to_dict()["encoder"] == "mine"
