@@ -8,6 +8,7 @@ Every error ends the command with one line on stderr naming the problem and exit
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import sys
 from pathlib import Path
@@ -18,13 +19,17 @@ from .runguard import add_run_options, run_command
 
 
 def _explore(args) -> int:
+    from dataclasses import replace
+
     from .envs import OdometryNoise
-    from .explore import explore
+    from .explore import default_config, explore
 
     out = Path(args.out)
     noise = OdometryNoise(slip=args.slip, heading_bias=args.heading_bias)
+    config = replace(default_config(args.env), encoder=args.encoder)
     metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
-                      patience=args.patience, noise=noise, checkpoint_every=args.checkpoint_every, resume=args.resume)
+                      patience=args.patience, noise=noise, config=config, checkpoint_every=args.checkpoint_every,
+                      resume=args.resume)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {out}/ (map.png, coverage.png, map.graphml, trajectory.csv, metrics.json, model.*)")
     return 0
@@ -92,6 +97,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = OneLineParser(prog="cogmap", description="Active-inference navigation toolkit")
     p.add_argument("--version", action="version", version=f"cogmap {__version__}")
     p.add_argument("--debug", action="store_true", help="show the full traceback of an error")
+    p.add_argument("--plugin", action="append", default=[], metavar="MODULE",
+                   help="import MODULE first (repeatable): its registrations (layouts, schemes, planners, "
+                        "EFE terms, encoders) are then known by name")
     sub = p.add_subparsers(dest="command", required=True)
 
     e = sub.add_parser("explore", help="AIMAPP exploration of a pybullet room")
@@ -110,6 +118,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "per metre)")
     e.add_argument("--heading-bias", type=float, default=0.0,
                    help="odometry drift: yaw error in rad per metre travelled (default: 0)")
+    e.add_argument("--encoder", default="ssim", help="observation encoder by name (default: ssim, the paper's; "
+                   "others from --plugin modules)")
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.add_argument("--checkpoint-every", type=positive_int, default=10, metavar="N",
@@ -191,6 +201,8 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     prog = f"cogmap {args.command}" + (f" {args.drone_command}" if args.command == "drone" else "")
     try:
+        for module in args.plugin:
+            importlib.import_module(module)
         if hasattr(args, "out_dir"):  # a run command: run directory checks and a wall-clock limit
             return run_command(args, prog, args.out_dir(args))
         return args.func(args)

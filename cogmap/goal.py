@@ -16,7 +16,7 @@ import numpy as np
 from cogmap.agent.aimapp import AIMAPPAgent
 from cogmap.agent.config import AgentConfig
 from cogmap.agent.correction import load_anchors
-from cogmap.agent.encoder import SSIMEncoder
+from cogmap.agent.encoder import make_encoder
 
 from .explore import episode_metrics, make_sim, run_agent, write_run
 
@@ -40,12 +40,14 @@ def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
     run = Path(run)
     manifest = json.loads((run / "run.json").read_text())
     cfg = AgentConfig.from_dict(manifest["config"])
-    encoder = SSIMEncoder(cfg.ssim_threshold)
+    encoder = make_encoder(cfg.encoder, cfg)  # the run's encoder, by name (register yours before loading)
+    if not hasattr(encoder, "add"):
+        raise ValueError(f"{run}: encoder '{cfg.encoder}' has no add(image) method to restore the run's observations")
     for png in sorted((run / "observations").glob("*.png")):
         encoder.add(cv2.cvtColor(cv2.imread(str(png)), cv2.COLOR_BGR2RGB))
     model = load(run / "model")
-    if len(encoder) != model.num_obs[0]:
-        raise ValueError(f"{run}: {len(encoder)} observation images for {model.num_obs[0]} model outcomes")
+    if len(encoder.images) != model.num_obs[0]:
+        raise ValueError(f"{run}: {len(encoder.images)} observation images for {model.num_obs[0]} model outcomes")
     agent = AIMAPPAgent(cfg, encoder=encoder, seed=seed, model=model)
     if (run / "anchors.npz").exists():
         agent.anchors = load_anchors(run / "anchors.npz")

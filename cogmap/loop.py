@@ -8,8 +8,9 @@ One ``step`` takes the observation of this time step (one entry per modality, an
 distribution; a dict by name works too), infers the state posterior with the registered
 inference scheme, optionally learns ``A`` (Eq. 8: counts += lr * o (x) q) and ``B`` (counts +=
 lr * q_t (x) q_t-1 for the control taken; dense transitions), evaluates policies by expected
-free energy (enumeration of every policy of ``policy_len`` steps, or MCTS) and picks the next
-control. The prior of the next step is the posterior pushed through ``B`` under that control.
+free energy with the planner registered under ``planner`` (built in: "enumerate", every policy
+of ``policy_len`` steps, or "mcts"; add one with :func:`cogmap.planning.register_planner`) and
+picks the next control. The prior of the next step is the posterior pushed through ``B`` under that control.
 
 The state is an immutable tuple; the model it holds is learnt in place when learning is on (as
 pymdp's ``Agent`` does). Policy precision ``gamma`` defaults to 16 (cogmap's planners); pymdp's
@@ -28,11 +29,8 @@ from cogmap.genmodel import Model, SpecError
 from cogmap.inference.learning import learn_observation
 from cogmap.planning import efe
 from cogmap.planning.decide import MODES, make_objective
-from cogmap.planning.decide import decide as mcts_decide
 from cogmap.planning.mcts import MCTSConfig
-from cogmap.planning.policies import infer_policies
-
-PLANNERS = ("enumerate", "mcts")
+from cogmap.planning.planners import PlanSettings, available_planners, get_planner
 
 
 class LoopConfig(NamedTuple):
@@ -155,9 +153,10 @@ def init(
     model : Model
         Compiled model.
     scheme : str, optional
-        Registered inference scheme, default ``"fpi"``.
+        Name in the inference registry (``cogmap.inference.register``), default ``"fpi"``.
     planner : str, optional
-        ``"enumerate"`` (every policy of ``policy_len`` steps, default) or ``"mcts"``.
+        Name in the planner registry (``cogmap.planning.register_planner``): ``"enumerate"``
+        (every policy of ``policy_len`` steps, default), ``"mcts"``, or one of your own.
     policy_len : int, optional
         Policy length for enumeration, an integer >= 1; default 1.
     gamma : float, optional
@@ -199,8 +198,8 @@ def init(
     if not isinstance(model, Model):
         raise TypeError(f"init needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")
     inference.get(scheme)  # unknown names fail here, listing the known ones
-    if planner not in PLANNERS:
-        raise ValueError(f"unknown planner '{planner}' (known: {', '.join(PLANNERS)})")
+    if not isinstance(planner, str) or planner not in available_planners():
+        raise ValueError(f"unknown planner {planner!r} (known: {', '.join(available_planners())})")
     if not (isinstance(policy_len, int | np.integer) and policy_len >= 1):
         raise ValueError(f"policy_len must be an integer >= 1, got {policy_len!r}")
     if not (np.isfinite(gamma) and gamma > 0):
@@ -265,16 +264,13 @@ def step(state: LoopState, observation) -> tuple[LoopState, StepInfo]:
     if cfg.learn_B and state.qs is not None:
         for f, u in enumerate(state.action):
             model.B[f].learn_soft(qs[f], state.qs[f], int(u), cfg.lr_B, model.num_states[f])
-    if cfg.planner == "enumerate":
-        action, q_pi, G, policies = infer_policies(model, qs, cfg.objective, length=cfg.policy_len, gamma=cfg.gamma,
-                                                   rng=state.rng if cfg.sample else None)
-        action = tuple(int(a) for a in action)
-    else:
-        mcfg = cfg.mcts or MCTSConfig(gamma=cfg.gamma)
-        d = mcts_decide(model, qs, None, cfg.objective, config=mcfg, rng=state.rng)
-        a = np.atleast_1d(np.asarray(d.action, dtype=int))
-        action = tuple(int(x) for x in a) + (0,) * (len(model.factors) - a.size)
-        q_pi, G, policies = None, np.asarray(d.Q), None
+    settings = PlanSettings(cfg.policy_len, cfg.gamma, state.rng, cfg.sample, cfg.mcts)
+    plan = get_planner(cfg.planner)(model, qs, cfg.objective, settings)
+    action = tuple(int(a) for a in plan.action)
+    if len(action) != len(model.factors):
+        raise ValueError(f"planner '{cfg.planner}' returned {len(action)} control(s), the model has "
+                         f"{len(model.factors)} factor(s)")
+    q_pi, G, policies = plan.q_pi, np.asarray(plan.G), plan.policies
     prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
     nxt = state._replace(prior=prior, qs=qs, action=action, t=state.t + 1)
     return nxt, StepInfo(qs, action, q_pi, G, policies, float(info.free_energy))

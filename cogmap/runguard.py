@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import io
 import json
 import shutil
@@ -109,6 +110,8 @@ def _child(spec: dict) -> dict:
     # would leave registered (the resource tracker then warns at exit)
     tqdm.set_lock(threading.RLock())
     args = spec["args"]
+    for module in getattr(args, "plugin", ()):  # the user's registrations (cogmap --plugin), in this process too
+        importlib.import_module(module)
     buf = io.StringIO()
     try:
         with contextlib.redirect_stdout(buf):

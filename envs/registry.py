@@ -1,8 +1,16 @@
-"""Gymnasium ids for every layout; registered on `import cogmap.envs`."""
+"""Gymnasium ids for every layout; registered on `import cogmap.envs`.
+
+:func:`register_layout` adds a user's room: ``make_layout(name)``, ``NavEnv(layout=name)``,
+``gymnasium.make(env_id)`` and ``cogmap explore --env NAME`` (or ``--env ENV_ID``) then find it.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import gymnasium as gym
+
+from .layouts import LAYOUTS, Layout
 
 MAX_STEPS = 500
 
@@ -41,3 +49,90 @@ def register_all() -> None:
     if MAZE_ID not in gym.registry:
         gym.register(MAZE_ID, entry_point="cogmap.envs.maze_env:LidarMazeEnv",
                      max_episode_steps=MAZE_MAX_STEPS)
+
+
+_BUILTIN_LAYOUTS = frozenset(LAYOUTS)
+
+
+def register_layout(name: str, factory: Callable[..., Layout], *, env_id: str | None = None,
+                    overwrite: bool = False, max_episode_steps: int = MAX_STEPS) -> None:
+    """Register a room under ``name`` (and optionally the Gymnasium id ``env_id``).
+
+    ``make_layout(name)``, ``NavEnv(layout=name)``, ``cogmap.explore.explore(name)`` and
+    ``cogmap explore --env NAME`` then find it; with ``env_id`` also ``gymnasium.make(env_id)``
+    and ``--env ENV_ID``.
+
+    Parameters
+    ----------
+    name : str
+        The room's name.
+    factory : callable
+        ``factory(seed: int = 0, **kwargs) -> Layout``; ``seed`` varies what the room
+        randomises, if anything. Called once here with ``seed=0`` so a broken factory fails now.
+    env_id : str, optional
+        A Gymnasium id to register on :class:`~cogmap.envs.gym_env.NavEnv`.
+    overwrite : bool
+        Replace a room (and id) registered earlier under the same name.
+    max_episode_steps : int
+        Episode length of the Gymnasium id (default 500, as the built-in rooms).
+
+    Raises
+    ------
+    ValueError
+        Empty name, a built-in layout name or id, a name or id already taken without
+        ``overwrite``, or a factory that does not return a :class:`Layout`.
+    TypeError
+        ``factory`` is not callable.
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"register_layout: name must be a non-empty string, got {name!r}")
+    if not callable(factory):
+        raise TypeError(f"register_layout('{name}'): expected a callable factory(seed) -> Layout, "
+                        f"got {type(factory).__name__}")
+    if name in _BUILTIN_LAYOUTS:
+        raise ValueError(f"register_layout: '{name}' is a built-in layout; choose another name")
+    if name in LAYOUTS and not overwrite:
+        raise ValueError(f"register_layout: a layout named '{name}' exists (pass overwrite=True)")
+    if env_id is not None:
+        if not isinstance(env_id, str) or not env_id:
+            raise ValueError(f"register_layout('{name}'): env_id must be a non-empty string, got {env_id!r}")
+        if env_id in LAYOUT_IDS and LAYOUT_IDS[env_id] in _BUILTIN_LAYOUTS:
+            raise ValueError(f"register_layout: '{env_id}' is a built-in environment id")
+        if env_id in gym.registry and not (overwrite and env_id in LAYOUT_IDS):
+            raise ValueError(f"register_layout: the Gymnasium id '{env_id}' is taken"
+                             + (" (pass overwrite=True)" if env_id in LAYOUT_IDS else ""))
+    built = factory(0)
+    if not isinstance(built, Layout):
+        raise ValueError(f"register_layout('{name}'): the factory returned {type(built).__name__}, not a Layout")
+    LAYOUTS[name] = factory
+    if env_id is not None:
+        LAYOUT_IDS[env_id] = name
+        gym.registry.pop(env_id, None)  # overwrite: replace our own earlier registration quietly
+        gym.register(env_id, entry_point="cogmap.envs.gym_env:NavEnv", kwargs={"layout": name},
+                     max_episode_steps=max_episode_steps)
+
+
+def unregister_layout(name: str) -> None:
+    """Remove a registered room and its Gymnasium ids.
+
+    Parameters
+    ----------
+    name : str
+        A name given to :func:`register_layout`.
+
+    Raises
+    ------
+    KeyError
+        No registered room has that name (the message lists the registered ones).
+    ValueError
+        ``name`` is a built-in layout.
+    """
+    if name in _BUILTIN_LAYOUTS:
+        raise ValueError(f"'{name}' is a built-in layout and cannot be removed")
+    if name not in LAYOUTS:
+        user = sorted(set(LAYOUTS) - _BUILTIN_LAYOUTS)
+        raise KeyError(f"no registered layout named {name!r} (registered: {user})")
+    del LAYOUTS[name]
+    for env_id in [i for i, lay in LAYOUT_IDS.items() if lay == name]:
+        del LAYOUT_IDS[env_id]
+        gym.registry.pop(env_id, None)

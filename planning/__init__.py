@@ -8,7 +8,8 @@ An agent loop makes one decision with :func:`decide`::
 
 Lower-level pieces are pure functions of arrays: :mod:`.efe` (terms, :func:`objective`,
 presets), :mod:`.policies` (enumeration, rollouts, softmax selection), :mod:`.mcts`,
-:mod:`.inductive`, :mod:`.astar`.
+:mod:`.inductive`, :mod:`.astar`. Extension points: :func:`register_term` (an EFE term usable by
+name in :func:`objective`) and :func:`register_planner` (a planner the agent loop finds by name).
 """
 
 from . import efe, inductive
@@ -19,6 +20,7 @@ from .decide import decide, make_objective
 from .efe import (
     Objective,
     a_novelty,
+    available_terms,
     b_novelty,
     collision,
     exploration,
@@ -28,10 +30,20 @@ from .efe import (
     observation_preference,
     param_info_gain,
     position_preference,
+    register_term,
     state_info_gain,
     state_preference,
+    unregister_term,
 )
 from .mcts import Decision, MCTSConfig, mcts, ucb_select
+from .planners import (
+    Plan,
+    PlanSettings,
+    available_planners,
+    get_planner,
+    register_planner,
+    unregister_planner,
+)
 from .policies import (
     enumerate_policies,
     evaluate_policies,
@@ -46,11 +58,15 @@ __all__ = [
     "LocalStep",
     "MCTSConfig",
     "Objective",
+    "Plan",
+    "PlanSettings",
     "PlanningArrays",
     "Prepared",
     "a_novelty",
     "astar_graph",
     "astar_grid",
+    "available_planners",
+    "available_terms",
     "b_novelty",
     "collision",
     "decide",
@@ -60,6 +76,7 @@ __all__ = [
     "exploration",
     "from_model",
     "full",
+    "get_planner",
     "goal",
     "inductive",
     "infer_policies",
@@ -70,9 +87,13 @@ __all__ = [
     "param_info_gain",
     "position_preference",
     "prepare",
+    "register_planner",
+    "register_term",
     "select",
     "policy_posterior",
     "state_info_gain",
     "state_preference",
     "ucb_select",
+    "unregister_planner",
+    "unregister_term",
 ]

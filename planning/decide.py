@@ -102,11 +102,13 @@ def decide(
         qs = [qs]
     obj = make_objective(mode, ind_w)
     cfg = config or MCTSConfig(depth=arrays.inductive_depth)
+    # a registered (user) term may read any attribute of the step context: prepare everything
+    user = any(w != 0.0 and not efe.is_builtin(t) for t, w in obj.terms)
     prep = prepare(
         arrays,
-        need_novelty=any(obj.uses(t) for t in (efe.param_info_gain, efe.a_novelty, efe.b_novelty,
-                                                efe.sensed_info_gain)),
-        need_goal=obj.uses(efe.inductive),
+        need_novelty=user or any(obj.uses(t) for t in (efe.param_info_gain, efe.a_novelty, efe.b_novelty,
+                                                        efe.sensed_info_gain)),
+        need_goal=user or obj.uses(efe.inductive),
     )
     with limited():
         return mcts(prep, qs, obj, obstacles, cfg, rng)

@@ -271,6 +271,120 @@ ALL_TERMS: dict[str, Term] = {
 #: terms whose value is information: gained once, so not counted again on a revisit (MCTS)
 EPISTEMIC = (state_info_gain, param_info_gain, a_novelty, b_novelty, sensed_info_gain)
 
+# -- user terms ------------------------------------------------------------------------------
+_USER_TERMS: dict[str, Term] = {}
+_USER_EPISTEMIC: dict[str, Term] = {}
+
+
+def register_term(name: str, term: Term, overwrite: bool = False, *, epistemic: bool = False) -> Term:
+    """Make ``term`` usable by name in :func:`objective` (and so in every planner).
+
+    Parameters
+    ----------
+    name : str
+        The name ``objective({name: weight})`` will accept.
+    term : callable
+        ``term(ctx) -> (K,)`` with the contract of the built-in terms (module docstring):
+        higher is better, the objective subtracts ``weight * term(ctx)`` from ``G``.
+    overwrite : bool
+        Replace a term registered under ``name`` (built-in terms cannot be replaced).
+    epistemic : bool
+        The value is information: counted once per imagined path when MCTS runs with
+        ``count_information_once`` (see :meth:`Objective.split`).
+
+    Returns
+    -------
+    callable
+        ``term``.
+
+    Raises
+    ------
+    ValueError
+        Empty name, a built-in name (:data:`ALL_TERMS`), or a name already registered without
+        ``overwrite``.
+    TypeError
+        ``term`` is not callable.
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"register_term: name must be a non-empty string, got {name!r}")
+    if not callable(term):
+        raise TypeError(f"register_term('{name}'): expected a callable term(ctx) -> (K,), got {type(term).__name__}")
+    if name in ALL_TERMS:
+        raise ValueError(f"register_term: '{name}' is a built-in EFE term; choose another name")
+    if name in _USER_TERMS and not overwrite and _USER_TERMS[name] is not term:
+        raise ValueError(f"register_term: a term named '{name}' exists (pass overwrite=True)")
+    _USER_TERMS[name] = term
+    _USER_EPISTEMIC.pop(name, None)
+    if epistemic:
+        _USER_EPISTEMIC[name] = term
+    return term
+
+
+def unregister_term(name: str) -> None:
+    """Remove a term added with :func:`register_term`.
+
+    Parameters
+    ----------
+    name : str
+        The registered name.
+
+    Raises
+    ------
+    KeyError
+        No registered term has that name (the message lists the registered ones).
+    """
+    if name not in _USER_TERMS:
+        raise KeyError(f"no registered EFE term named {name!r} (registered: {sorted(_USER_TERMS)})")
+    del _USER_TERMS[name]
+    _USER_EPISTEMIC.pop(name, None)
+
+
+def available_terms() -> tuple[str, ...]:
+    """Names :func:`objective` accepts.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names of the built-in and the registered terms.
+    """
+    return tuple(sorted({*ALL_TERMS, *_USER_TERMS}))
+
+
+def is_builtin(term: Term) -> bool:
+    """Whether ``term`` is one of this module's terms.
+
+    The planners prepare exactly what the built-in terms read; a user term may read any
+    attribute of the step context, so with one in an objective everything is prepared.
+
+    Parameters
+    ----------
+    term : callable
+        A term function.
+
+    Returns
+    -------
+    bool
+        True for a term of :data:`ALL_TERMS`.
+    """
+    return term in ALL_TERMS.values()
+
+
+def is_epistemic(term: Term) -> bool:
+    """Whether ``term``'s value is information.
+
+    Parameters
+    ----------
+    term : callable
+        A term function.
+
+    Returns
+    -------
+    bool
+        True for the built-in epistemic terms (:data:`EPISTEMIC`) and terms registered with
+        ``epistemic=True``; :meth:`Objective.split` leaves those out of a revisited step's value.
+    """
+    return term in EPISTEMIC or term in _USER_EPISTEMIC.values()
+
 
 # -- combinator ------------------------------------------------------------------------------
 @dataclass(frozen=True)
@@ -319,7 +433,7 @@ class Objective:
             if w != 0.0:
                 v = w * term(ctx)
                 g -= v
-                if term not in EPISTEMIC:
+                if not is_epistemic(term):
                     g_known -= v
         return g, g_known
 
@@ -364,7 +478,8 @@ def objective(terms: Sequence[tuple[Term | str, float]] | dict) -> Objective:
     Parameters
     ----------
     terms : sequence of (callable or str, float) or dict
-        Term functions or names from ``ALL_TERMS`` with their weights.
+        Term functions or names (the built-in ones of ``ALL_TERMS`` and those added with
+        :func:`register_term`) with their weights; a dict ``{term: weight}`` works too.
 
     Returns
     -------
@@ -381,9 +496,12 @@ def objective(terms: Sequence[tuple[Term | str, float]] | dict) -> Objective:
     out = []
     for t, w in items:
         if isinstance(t, str):
-            if t not in ALL_TERMS:
-                raise KeyError(f"unknown EFE term '{t}' (known: {sorted(ALL_TERMS)})")
-            t = ALL_TERMS[t]
+            if t in ALL_TERMS:
+                t = ALL_TERMS[t]
+            elif t in _USER_TERMS:
+                t = _USER_TERMS[t]
+            else:
+                raise KeyError(f"unknown EFE term '{t}' (known: {list(available_terms())})")
         if not callable(t):
             raise TypeError(f"EFE term {t!r} is not callable")
         out.append((t, float(w)))

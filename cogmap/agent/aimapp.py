@@ -41,7 +41,7 @@ from . import planner
 from .confidence import Confidence, assess, cusum
 from .config import AgentConfig
 from .correction import Anchor, relocalise, to_frame_panorama, track
-from .encoder import Encoder, SSIMEncoder, check_encoder
+from .encoder import Encoder, check_encoder, make_encoder
 from .mapping import direction, expansion_free_energies, reverse_heading
 from .sensing import blocked
 from .viewmap import ViewMap
@@ -103,7 +103,7 @@ class AIMAPPAgent:
     def __init__(self, config: AgentConfig | None = None, encoder: Encoder | None = None, seed: int = 0,
                  model: Model | None = None):
         self.cfg = config or AgentConfig()
-        self.encoder: Encoder = encoder if encoder is not None else SSIMEncoder(self.cfg.ssim_threshold)
+        self.encoder: Encoder = encoder if encoder is not None else make_encoder(self.cfg.encoder, self.cfg)
         check_encoder(self.encoder)
         self.rng = np.random.default_rng(seed)
         self.model = model

@@ -15,6 +15,7 @@ class AgentConfig:
     node_spacing: float = 0.9  # a predicted pose is beyond a node's influence past this x radius
     lookahead_nodes: int = 8  # at most this many new states per expansion (Table 6)
     ssim_threshold: float = 0.65  # place recognition (Table 6)
+    encoder: str = "ssim"  # observation encoder by name (cogmap.agent.encoder.register_encoder)
     mcts_depth: int = 10  # Appendix A.3
     mcts_simulations: int = 30
     mcts_count_information_once: bool = False  # Eq. 5 sums every step's EFE (see MCTSConfig)
@@ -78,7 +79,12 @@ class AgentConfig:
         return self.pose_sigma if self.pose_sigma is not None else self.influence_radius / 3
 
     def to_dict(self) -> dict:
-        return asdict(self)
+        d = asdict(self)
+        if d["encoder"] == "ssim":
+            # the paper's encoder is left implicit (from_dict restores it), so the manifests and
+            # study run keys of runs made before encoders were chosen by name stay the same
+            del d["encoder"]
+        return d
 
     @classmethod
     def from_dict(cls, d: dict) -> AgentConfig:

@@ -5,6 +5,10 @@ serve (section 3.1, sensor agnosticism). :class:`SSIMEncoder` is the paper's: a 
 matched against the stored ones by structural similarity (Wang et al. 2004, Gaussian window
 11 / sigma 1.5) and a score below the threshold (0.65) makes it a new observation.
 
+Encoders are chosen by name: ``AgentConfig(encoder="ssim")`` (the default) and
+:func:`register_encoder` adds a factory ``factory(config) -> Encoder`` under a new name, which
+:class:`~cogmap.agent.aimapp.AIMAPPAgent` (and so ``cogmap.explore``) then builds.
+
 Per-image statistics (local means and variances) are cached when an image is stored, and the
 stored images are compared in channel-stacked batches, so one query against hundreds of stored
 panoramas costs a handful of OpenCV calls.
@@ -12,7 +16,7 @@ panoramas costs a handful of OpenCV calls.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Protocol, runtime_checkable
 
 import numpy as np
@@ -243,3 +247,132 @@ class SSIMEncoder:
         if best >= 0 and score >= self.threshold:
             return best, False
         return self.add(image), True
+
+
+# -- encoders by name ----------------------------------------------------------------------------
+def _ssim_encoder(config) -> SSIMEncoder:
+    """The paper's encoder (section 3.1) with the configured threshold (Table 6: 0.65).
+
+    Parameters
+    ----------
+    config : AgentConfig
+        Reads ``ssim_threshold``.
+
+    Returns
+    -------
+    SSIMEncoder
+        A new, empty encoder.
+    """
+    return SSIMEncoder(config.ssim_threshold)
+
+
+_BUILTIN_ENCODERS = {"ssim": _ssim_encoder}
+_ENCODERS: dict[str, Callable] = dict(_BUILTIN_ENCODERS)
+
+
+def register_encoder(name: str, factory: Callable | None = None, *, overwrite: bool = False):
+    """Register an encoder factory under ``name``; ``AgentConfig(encoder=name)`` then selects it.
+
+    Parameters
+    ----------
+    name : str
+        The name for ``AgentConfig.encoder``.
+    factory : callable, optional
+        ``factory(config: AgentConfig) -> Encoder``, called once per agent. Omitted: returns a
+        decorator.
+    overwrite : bool
+        Replace a factory registered under ``name`` (the built-in ``"ssim"`` cannot be replaced).
+
+    Returns
+    -------
+    callable
+        ``factory`` (or the decorator registering it).
+
+    Raises
+    ------
+    ValueError
+        Empty or built-in name, or a name already taken without ``overwrite``.
+    TypeError
+        ``factory`` is not callable, or is an encoder itself rather than a factory.
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"register_encoder: name must be a non-empty string, got {name!r}")
+
+    def _add(f: Callable) -> Callable:
+        if not callable(f) or isinstance(f, Encoder):
+            got = (f"the encoder {type(f).__name__} itself (register lambda config: ... returning a new one)"
+                   if callable(f) else type(f).__name__)
+            raise TypeError(f"register_encoder('{name}'): expected a callable factory(config) -> Encoder, got {got}")
+        if name in _BUILTIN_ENCODERS and _ENCODERS.get(name) is not f:
+            raise ValueError(f"register_encoder: '{name}' is a built-in encoder; choose another name")
+        if name in _ENCODERS and not overwrite and _ENCODERS[name] is not f:
+            raise ValueError(f"register_encoder: an encoder named '{name}' exists (pass overwrite=True)")
+        _ENCODERS[name] = f
+        return f
+
+    return _add if factory is None else _add(factory)
+
+
+def unregister_encoder(name: str) -> None:
+    """Remove a registered encoder factory.
+
+    Parameters
+    ----------
+    name : str
+        A name given to :func:`register_encoder`.
+
+    Raises
+    ------
+    KeyError
+        No encoder has that name (the message lists the registered ones).
+    ValueError
+        ``name`` is a built-in encoder.
+    """
+    if name in _BUILTIN_ENCODERS:
+        raise ValueError(f"'{name}' is a built-in encoder and cannot be removed")
+    if name not in _ENCODERS:
+        raise KeyError(f"no encoder named {name!r} (available: {', '.join(available_encoders())})")
+    del _ENCODERS[name]
+
+
+def available_encoders() -> tuple[str, ...]:
+    """Names ``AgentConfig.encoder`` accepts.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names, the built-in ``"ssim"`` included.
+    """
+    return tuple(sorted(_ENCODERS))
+
+
+def make_encoder(name: str, config) -> Encoder:
+    """Build the encoder registered as ``name`` and check it follows :class:`Encoder`.
+
+    Parameters
+    ----------
+    name : str
+        A registered encoder name (``AgentConfig.encoder``).
+    config : AgentConfig
+        Passed to the factory.
+
+    Returns
+    -------
+    Encoder
+        A new encoder.
+
+    Raises
+    ------
+    KeyError
+        Unknown name; the message lists the registered ones.
+    TypeError
+        The factory's result lacks a member of the :class:`Encoder` protocol.
+    """
+    try:
+        factory = _ENCODERS[name]
+    except (KeyError, TypeError):
+        raise KeyError(f"unknown encoder {name!r} (available: {', '.join(available_encoders())})") from None
+    encoder = factory(config)
+    check_encoder(encoder)
+    return encoder
+

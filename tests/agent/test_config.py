@@ -25,6 +25,8 @@ def _other(value):
         return 0.123
     if isinstance(value, tuple):
         return tuple(_other(v) for v in value)
+    if isinstance(value, str):
+        return value + "_other"
     raise TypeError(value)
 
 
@@ -89,3 +91,10 @@ def test_cell_encoder_match_stores_nothing():
     assert enc((0.2, 0.2)) == (0, True)
     assert enc.match((0.7, 0.4)) == (0, 1.0) and enc.match((1.5, 0.2)) == (-1, 0.0)
     assert len(enc.ids) == 1
+
+
+def test_the_default_encoder_is_implicit_in_saved_configs():
+    """Run keys of the studies digest the saved config: the paper's encoder adds no key to it."""
+    assert "encoder" not in AgentConfig().to_dict()
+    assert AgentConfig.from_dict(AgentConfig().to_dict()).encoder == "ssim"
+    assert AgentConfig(encoder="mine").to_dict()["encoder"] == "mine"

@@ -1,0 +1,242 @@
+"""Planners by name: how an agent loop turns a belief into the next control.
+
+A planner is any callable
+
+    plan = planner(model, qs, objective, settings)
+
+* ``model``: the compiled :class:`cogmap.genmodel.Model` (or :class:`~.arrays.PlanningArrays`);
+* ``qs``: the current belief, one array per factor (live length ``n_f``);
+* ``objective``: an :class:`~.efe.Objective` (call it on a step context to get the per-step
+  expected free energy ``G`` per candidate, lower is better);
+* ``settings``: a :class:`PlanSettings` (policy length, precision, the loop's RNG, whether to
+  sample, the MCTS configuration), read what you need and ignore the rest;
+
+returning a :class:`Plan`: ``action`` (one integer control per factor), ``G`` (the EFE of what
+was compared: per policy, per root action, ...) and optionally ``q_pi`` and ``policies``.
+:mod:`cogmap.loop` calls it once per step, after inference and learning, and looks it up by the
+name given to ``loop.init(planner=...)``. Two are built in: ``"enumerate"`` (every policy of
+``policy_len`` steps, :func:`~.policies.infer_policies`) and ``"mcts"`` (:func:`~.decide.decide`).
+Add yours with :func:`register_planner` without touching this package.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+
+from .mcts import MCTSConfig
+
+
+class PlanSettings(NamedTuple):
+    """What the loop passes to every planner (a planner reads only what it needs).
+
+    Attributes
+    ----------
+    policy_len : int
+        Steps per policy (enumeration).
+    gamma : float
+        Policy precision: ``q(pi) = softmax(-gamma G)`` (Eq. 4 of the AIMAPP paper).
+    rng : numpy.random.Generator or None
+        The loop's generator; use it for any randomness so runs are reproducible.
+    sample : bool
+        Sample the action from ``q(pi)``; False takes its mode.
+    mcts : MCTSConfig or None
+        Depth and simulations for tree search (None: the defaults).
+    """
+
+    policy_len: int = 1  # steps per policy (enumeration)
+    gamma: float = 16.0  # policy precision, q(pi) = softmax(-gamma G) (Eq. 4)
+    rng: np.random.Generator | None = None  # the loop's generator (the loop owns its state)
+    sample: bool = True  # sample the action from q(pi); False: take its mode
+    mcts: MCTSConfig | None = None  # depth / simulations for tree search (None: defaults)
+
+
+class Plan(NamedTuple):
+    """A planner's answer.
+
+    Attributes
+    ----------
+    action : tuple of int
+        One control per factor, to apply now.
+    G : numpy.ndarray
+        Expected free energy (nats) of what was compared: per policy, per root action, ...
+    q_pi : numpy.ndarray or None
+        Posterior over those policies, if the planner has one.
+    policies : numpy.ndarray or None
+        ``(P, T, F)`` policies of ``q_pi`` and ``G`` (enumeration).
+    """
+
+    action: tuple  # one integer control per factor, to apply now
+    G: np.ndarray  # expected free energy of what was compared (per policy, per root action, ...)
+    q_pi: np.ndarray | None = None  # posterior over those policies, if the planner has one
+    policies: np.ndarray | None = None  # (P, T, F) policies of q_pi and G (enumeration)
+
+
+Planner = Callable[..., Plan]
+
+_PLANNERS: dict[str, Planner] = {}
+
+
+def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = False):
+    """Register planner ``fn`` under ``name``; usable as a decorator (``@register_planner("mine")``).
+
+    Parameters
+    ----------
+    name : str
+        The name ``cogmap.loop.init(planner=name)`` will use.
+    fn : callable, optional
+        ``fn(model, qs, objective, settings) -> Plan`` (module docstring). Omitted: returns a
+        decorator.
+    overwrite : bool
+        Replace a planner registered under ``name`` (the built-in ``"enumerate"`` and
+        ``"mcts"`` cannot be replaced).
+
+    Returns
+    -------
+    callable
+        ``fn`` (or the decorator registering it).
+
+    Raises
+    ------
+    ValueError
+        Empty name, a built-in name, or a name already taken without ``overwrite``.
+    TypeError
+        ``fn`` is not callable.
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"register_planner: name must be a non-empty string, got {name!r}")
+
+    def _add(f: Planner) -> Planner:
+        if not callable(f):
+            raise TypeError(f"register_planner('{name}'): expected a callable, got {type(f).__name__}")
+        if name in BUILTIN and _PLANNERS.get(name) is not f:
+            raise ValueError(f"register_planner: '{name}' is a built-in planner and cannot be replaced")
+        if name in _PLANNERS and not overwrite and _PLANNERS[name] is not f:
+            raise ValueError(f"register_planner: a planner named '{name}' exists (pass overwrite=True)")
+        _PLANNERS[name] = f
+        return f
+
+    return _add if fn is None else _add(fn)
+
+
+def unregister_planner(name: str) -> None:
+    """Remove a registered planner.
+
+    Parameters
+    ----------
+    name : str
+        A name given to :func:`register_planner`.
+
+    Raises
+    ------
+    KeyError
+        No planner has that name (the message lists the registered ones).
+    ValueError
+        ``name`` is a built-in planner.
+    """
+    if name in BUILTIN:
+        raise ValueError(f"'{name}' is a built-in planner and cannot be removed")
+    if name not in _PLANNERS:
+        raise KeyError(f"no planner named '{name}' (available: {', '.join(available_planners())})")
+    del _PLANNERS[name]
+
+
+def get_planner(name: str) -> Planner:
+    """The planner registered as ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A built-in (``"enumerate"``, ``"mcts"``) or registered planner name.
+
+    Returns
+    -------
+    callable
+        ``planner(model, qs, objective, settings) -> Plan``.
+
+    Raises
+    ------
+    KeyError
+        Unknown name; the message lists the registered ones.
+    """
+    try:
+        return _PLANNERS[name]
+    except (KeyError, TypeError):
+        raise KeyError(f"unknown planner {name!r} (available: {', '.join(available_planners())})") from None
+
+
+def available_planners() -> tuple[str, ...]:
+    """Names of every planner the loop can use.
+
+    Returns
+    -------
+    tuple of str
+        Sorted names, the built-in ones included.
+    """
+    return tuple(sorted(_PLANNERS))
+
+
+# -- the two built-in planners -----------------------------------------------------------------
+def enumerate_planner(model, qs, objective, settings: PlanSettings) -> Plan:
+    """Every policy of ``settings.policy_len`` steps, ``q(pi) = softmax(-gamma G)`` (Eq. 4).
+
+    Parameters
+    ----------
+    model : Model or PlanningArrays
+        The model to plan with.
+    qs : list of numpy.ndarray
+        Current belief, one ``(n_f,)`` array per factor.
+    objective : Objective
+        Per-step expected free energy.
+    settings : PlanSettings
+        Policy length, precision, RNG and whether to sample.
+
+    Returns
+    -------
+    Plan
+        First action of the chosen policy, ``G`` and ``q(pi)`` per policy, the policies.
+    """
+    from .policies import infer_policies
+
+    rng = settings.rng if settings.sample else None
+    action, q_pi, G, policies = infer_policies(model, qs, objective, length=settings.policy_len,
+                                               gamma=settings.gamma, rng=rng)
+    return Plan(tuple(int(a) for a in action), G, q_pi, policies)
+
+
+def mcts_planner(model, qs, objective, settings: PlanSettings) -> Plan:
+    """MCTS over EFE (Appendix A.3 of the AIMAPP paper) through :func:`~.decide.decide`.
+
+    Parameters
+    ----------
+    model : Model or PlanningArrays
+        The model to plan with.
+    qs : list of numpy.ndarray
+        Current belief, one ``(n_f,)`` array per factor.
+    objective : Objective
+        Per-step expected free energy.
+    settings : PlanSettings
+        ``settings.mcts`` (default: ``MCTSConfig(gamma=settings.gamma)``) and the RNG.
+
+    Returns
+    -------
+    Plan
+        The chosen control per factor (0 for factors the search does not move) and the
+        backed-up EFE per root action; no ``q_pi``.
+    """
+    from .decide import decide
+
+    mcfg = settings.mcts or MCTSConfig(gamma=settings.gamma)
+    d = decide(model, qs, None, objective, config=mcfg, rng=settings.rng)
+    a = np.atleast_1d(np.asarray(d.action, dtype=int))
+    num_factors = len(qs)
+    return Plan(tuple(int(x) for x in a) + (0,) * (num_factors - a.size), np.asarray(d.Q))
+
+
+BUILTIN = {"enumerate": enumerate_planner, "mcts": mcts_planner}
+_PLANNERS.update(BUILTIN)
+
+__all__ = ["Plan", "PlanSettings", "available_planners", "enumerate_planner", "get_planner", "mcts_planner",
+           "register_planner", "unregister_planner"]
