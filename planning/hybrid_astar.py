@@ -19,7 +19,8 @@ Edge weight (Section V-A, Appendix C-A): travelled distance plus the safety term
 
 Heuristic: Dolgov's "holonomic with obstacles" cost-to-go, a Dijkstra search from the goal over a
 grid of position cells whose edge costs use the same scan function (length plus the safety term
-per ``step`` of travel); ``euclid`` (straight-line distance, admissible) is the other choice.
+per ``step`` of travel); ``euclid`` (straight-line distance, admissible) is the other choice. The
+heuristic is weighted (``heuristic_weight``, weighted A*), so plans are near-optimal, not optimal.
 When an expanded node lies within ``shot_radius`` of the goal and the reading toward the goal
 clears the remaining distance, a straight shot ends the search (the analytic expansion of hybrid
 A*); a last pure rotation turns the agent to the goal heading.
@@ -70,8 +71,10 @@ class HybridAStarConfig:
     ``2 pi k / n_beams``; ``None``: every beam direction); ``cell`` and ``heading_bins``: the search
     discretisation; ``clearance``: extra free distance a forward move needs beyond its length;
     ``shot_radius``: distance to the goal from which a straight shot is tried (default ``2 * step``);
-    ``heuristic``: ``"grid"`` (holonomic with obstacles) or ``"euclid"``; ``max_expansions``: search
-    budget; ``turn_heading``: end with a rotation to the goal heading."""
+    ``heuristic``: ``"grid"`` (holonomic with obstacles) or ``"euclid"``; ``heuristic_weight``: weighted
+    A* factor on the heuristic (1: plain A*; 1.5 by default: on maze 1 it cut the expansions of long
+    plans about tenfold at costs within 5 %); ``max_expansions``: search budget; ``turn_heading``: end
+    with a rotation to the goal heading."""
 
     step: float = 0.025
     turns: tuple[int, ...] | None = None
@@ -81,6 +84,7 @@ class HybridAStarConfig:
     shot_radius: float | None = None
     safety: SafetyTerm = SafetyTerm()
     heuristic: str = "grid"
+    heuristic_weight: float = 1.5
     max_expansions: int = 20000
     turn_heading: bool = True
 
@@ -92,6 +96,8 @@ class HybridAStarConfig:
                              f"sqrt(2) * cell ({math.sqrt(2) * self.cell:.4g}) so every move leaves its cell")
         if self.clearance < 0:
             raise ValueError(f"HybridAStarConfig: clearance must be >= 0, got {self.clearance}")
+        if self.heuristic_weight < 1:
+            raise ValueError(f"HybridAStarConfig: heuristic_weight must be >= 1, got {self.heuristic_weight}")
         if self.heuristic not in ("grid", "euclid"):
             raise ValueError(f"HybridAStarConfig: heuristic must be 'grid' or 'euclid', got {self.heuristic!r}")
 
@@ -302,7 +308,7 @@ def plan_path(start, goal, scan_fn: ScanFn, extent: float, config: HybridAStarCo
             parents.append(i)
             ctrls.append(np.array([turn_angles[t], step]))
             best[kq] = len(poses) - 1
-            heapq.heappush(heap, (gq + heuristic(q), gq, len(poses) - 1))
+            heapq.heappush(heap, (gq + config.heuristic_weight * heuristic(q), gq, len(poses) - 1))
     return _fail(f"goal unreachable: the search closed all {expansions} reachable cells", start, expansions,
                  queries, tic)
 

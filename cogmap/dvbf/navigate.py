@@ -199,10 +199,11 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
                  complexity: str = "moderate", corridor: str = "medium", model_dir: Path | None = None,
                  map_steps: int = 2000, map_iters: int = 3000, pretrain_maze: int | None = None,
                  pretrain_iters: int = 1500, config: HybridAStarConfig | None = None, progress: bool = True,
-                 model=None) -> dict:
+                 model=None, grid: int = GRID) -> dict:
     """Navigation on maze ``maze_seed``: learn (or load) the model, plan and execute ``pairs`` seeded
-    pose pairs (None: all 600) in the learned model and in the true simulator, and write the run
-    directory to ``out`` (if given). ``model``: an already learnt ``(params, cfg, info)``. Returns
+    pose pairs (None: all ordered pairs; 600 for the 5 x 5 grid) in the learned model and in the true
+    simulator, and write the run directory to ``out`` (if given). ``model``: an already learnt
+    ``(params, cfg, info)``; ``grid``: poses per side (at most the maze's cells per side). Returns
     the metrics."""
     from cogmap.envs.maze_sim import MazeSim
 
@@ -221,7 +222,7 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     if abs(cfg.extent - maze.size) > 1e-9:
         raise ValueError(f"navigate_run: the model covers a world of side {cfg.extent}, maze {maze_seed} has "
                          f"side {maze.size}")
-    poses = grid_poses(maze, GRID, seed)
+    poses = grid_poses(maze, grid, seed)
     chosen = pose_pairs(len(poses), pairs, seed)
     true_sim = MazeSim(maze)
     bar = None
