@@ -76,7 +76,8 @@ def test_wall_forces_a_detour():
     wall = (0.5, 0.0, 0.5, 0.7)
     scan = segment_scan([*BOX, wall])
     start, goal = np.array([0.25, 0.25, 0.0]), np.array([0.75, 0.25, 0.0])
-    plans = {h: plan_path(start, goal, scan, 1.0, HybridAStarConfig(heuristic=h)) for h in ("grid", "euclid")}
+    plans = {h: plan_path(start, goal, scan, 1.0, HybridAStarConfig(step=0.04, cell=0.025, heuristic=h))
+             for h in ("grid", "euclid")}
     for plan in plans.values():
         assert plan.found, plan.reason
         shortest = 2 * math.hypot(0.25, 0.45)  # around the wall's tip at (0.5, 0.7)
@@ -90,13 +91,13 @@ def test_wall_forces_a_detour():
     # the holonomic-with-obstacles heuristic expands fewer nodes than the straight-line one, at a
     # cost close to that of the admissible search
     assert plans["grid"].expansions < plans["euclid"].expansions
-    assert plans["grid"].cost <= 1.1 * plans["euclid"].cost
+    assert plans["grid"].cost <= 1.2 * plans["euclid"].cost
 
 
 def test_unreachable_goal_is_a_clear_failure():
     pen = [(0.6, 0.6, 0.9, 0.6), (0.9, 0.6, 0.9, 0.9), (0.9, 0.9, 0.6, 0.9), (0.6, 0.9, 0.6, 0.6)]
     scan = segment_scan([*BOX, *pen])
-    cfg = HybridAStarConfig(step=0.05, cell=0.03, heading_bins=4)
+    cfg = HybridAStarConfig(step=0.05, cell=0.03, heading_bins=2)
     plan = plan_path([0.2, 0.2, 0.0], [0.75, 0.75, 0.0], scan, 1.0, cfg)
     assert not plan.found
     assert "unreachable" in plan.reason
