@@ -59,9 +59,12 @@ def test_learned_model_predicts_the_walls(small_model):
     poses = grid_poses(maze, 3)
     with MazeSim(maze) as sim:
         truth = sim.lidar_batch(poses)
-    pred = learned_scan_fn(params, cfg)(poses)
+    pred = learned_scan_fn(params, cfg, k_std=0.0)(poses)
     assert pred.shape == truth.shape
     assert np.median(np.abs(pred - truth)) < 0.03
+    # the planning ranges lie below the mean by the prediction's spread under q(M)
+    low = learned_scan_fn(params, cfg)(poses)
+    assert np.all(low < pred) and np.median(pred - low) > 1e-4
 
 
 def test_learned_plan_is_collision_free_on_an_easy_pair(small_model):
