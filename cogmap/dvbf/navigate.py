@@ -216,11 +216,11 @@ def summarise(rows: list[dict]) -> dict:
     return out
 
 
-def scan_models(params, cfg, sim) -> dict:
-    """The three worlds each pair is planned in: ``learned`` (q(M), ranges lowered by :data:`STD_K`
+def scan_models(params, cfg, sim, k_std: float = STD_K) -> dict:
+    """The three worlds each pair is planned in: ``learned`` (q(M), ranges lowered by ``k_std``
     standard deviations), ``learned_mean`` (the prediction at the map mean, the paper's reading) and
     ``true`` (the simulator's ray casts, the reference row)."""
-    return {"learned": learned_scan_fn(params, cfg), "learned_mean": learned_scan_fn(params, cfg, 0.0),
+    return {"learned": learned_scan_fn(params, cfg, k_std), "learned_mean": learned_scan_fn(params, cfg, 0.0),
             "true": sim.lidar_batch}
 
 

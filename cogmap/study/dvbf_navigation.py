@@ -23,8 +23,10 @@ SCALES = {
     "reduced": {"mazes": [1, 2], "pairs": 30, "block": 30},
     "tiny": {"mazes": [1], "pairs": 2, "block": 2},
 }
-MODEL = {"full": {"map_steps": 2000, "map_iters": 3000}, "reduced": {"map_steps": 2000, "map_iters": 3000},
-         "tiny": {"map_steps": 300, "map_iters": 30}}
+_LEARN = {"map_side_factor": 2, "sigma_e": 0.03, "hidden": 64}  # cogmap.dvbf.navigate.learn_model's defaults
+MODEL = {"full": {"map_steps": 2000, "map_iters": 3000, **_LEARN},
+         "reduced": {"map_steps": 2000, "map_iters": 3000, **_LEARN},
+         "tiny": {"map_steps": 300, "map_iters": 30, **_LEARN}}
 # paper (Section V-B b, c; Figure 6c): every pose-to-pose plan reached its target; pose-to-observation
 # under 2 % failures; planning in the true simulator is the upper bound
 PAPER = {"pose_to_pose_success": 1.0, "pose_to_observation_failures_below": 0.02}
@@ -52,7 +54,7 @@ def _maze_seed(env: str) -> int:
 
 
 def nav_specs(plan: dict) -> list[dict]:
-    from cogmap.dvbf.navigate import GRID, pose_pairs
+    from cogmap.dvbf.navigate import GRID, STD_K, pose_pairs
     from cogmap.planning.hybrid_astar import HybridAStarConfig
 
     from .config import spec_digest
@@ -67,7 +69,8 @@ def nav_specs(plan: dict) -> list[dict]:
                 spec = {"study": STUDY, "scale": plan["scale"], "env": env, "method": "hybrid_astar",
                         "seed": int(seed), "level": f"block{b}", "noise": None, "steps": 0,
                         "stop_rule": plan["stop_rule"], "coverage_level": plan["coverage_level"],
-                        "success_rule": plan["success_rule"], "method_options": {"planner": planner},
+                        "success_rule": plan["success_rule"], "method_options": {"planner": planner, "worlds": {
+                            "learned": {"k_std": STD_K}, "learned_mean": {"k_std": 0.0}, "true": "pybullet"}},
                         "params": {**p, "first": first, "last": min(first + p["block"], n)}}
                 specs.append({"key": f"{env}__hybrid_astar__s{seed}__block{b}__{spec_digest(spec)}", **spec})
     return specs
@@ -78,14 +81,16 @@ LABELS = {"learned": "DVBF-LM, mean - 1 std", "learned_mean": "DVBF-LM, mean (pa
 _MODELS: dict = {}
 
 
-def _model(maze_seed: int, seed: int, steps: int, iters: int):
+def _model(maze_seed: int, seed: int, p: dict):
     from cogmap.dvbf.navigate import learn_model
     from cogmap.envs.maze import make_maze
 
-    key = (maze_seed, seed, steps, iters)
+    key = (maze_seed, seed, p["map_steps"], p["map_iters"], p["map_side_factor"], p["sigma_e"], p["hidden"])
     if key not in _MODELS:
         _MODELS.clear()  # one model in memory at a time
-        _MODELS[key] = learn_model(make_maze(maze_seed), steps, iters, seed=seed)
+        maze = make_maze(maze_seed)
+        _MODELS[key] = learn_model(maze, p["map_steps"], p["map_iters"], seed=seed, hidden=p["hidden"],
+                                   map_side=p["map_side_factor"] * maze.map_side, sigma_e=p["sigma_e"])
     return _MODELS[key]
 
 
@@ -98,7 +103,7 @@ def run_navigation(spec: dict) -> dict:
     p = spec["params"]
     maze_seed = _maze_seed(spec["env"])
     maze = make_maze(maze_seed)
-    params, cfg, info = _model(maze_seed, spec["seed"], p["map_steps"], p["map_iters"])
+    params, cfg, info = _model(maze_seed, spec["seed"], p)
     opts = dict(spec["method_options"]["planner"])
     opts["safety"] = SafetyTerm(**opts["safety"])
     opts["turns"] = tuple(opts["turns"]) if opts["turns"] is not None else None
@@ -107,7 +112,9 @@ def run_navigation(spec: dict) -> dict:
     pairs = pose_pairs(len(poses), p["pairs"], spec["seed"])[p["first"]:p["last"]]
     sim = MazeSim(maze)
     try:
-        rows, extra = navigate_pairs(maze, scan_models(params, cfg, sim), poses, pairs, config)
+        worlds = spec["method_options"]["worlds"]
+        rows, extra = navigate_pairs(maze, scan_models(params, cfg, sim, worlds["learned"]["k_std"]), poses, pairs,
+                                     config)
     finally:
         sim.close()
     h = hashlib.sha256()
