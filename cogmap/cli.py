@@ -78,8 +78,8 @@ def _dvbf_navigate(args) -> int:
 
     metrics = navigate_run(args.maze, Path(args.out), pairs=args.pairs, seed=args.seed,
                            model_dir=Path(args.model) if args.model else None, progress=not args.quiet)
-    print(json.dumps({k: v for k, v in metrics.items() if k in ("maze_seed", "pairs", "learned", "true",
-                                                                "length_ratio")}, indent=1))
+    shown = ("maze_seed", "pairs", "learned", "learned_mean", "true", "length_ratio", "length_ratio_learned_mean")
+    print(json.dumps({k: v for k, v in metrics.items() if k in shown}, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, pairs.csv, poses.csv, metrics.json, paths.png)")
     return 0
 
