@@ -1,5 +1,5 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap drone fly``, ``cogmap dvbf slam``, ``cogmap reproduce``.
+``cogmap drone fly``, ``cogmap dvbf slam``, ``cogmap dvbf navigate``, ``cogmap reproduce``.
 
 Every error ends the command with one line on stderr naming the problem and exit status 2
 (``--debug`` shows the traceback instead); ``cogmap --version`` prints the version.
@@ -84,6 +84,17 @@ def _dvbf(args) -> int:
                        pretrain_maze=pre)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, error.png, map.png)")
+    return 0
+
+
+def _dvbf_navigate(args) -> int:
+    from .dvbf.navigate import navigate_run
+
+    metrics = navigate_run(args.maze, Path(args.out), pairs=args.pairs, seed=args.seed,
+                           model_dir=Path(args.model) if args.model else None, progress=not args.quiet)
+    shown = ("maze_seed", "pairs", "learned", "learned_mean", "true", "length_ratio", "length_ratio_learned_mean")
+    print(json.dumps({k: v for k, v in metrics.items() if k in shown}, indent=1))
+    print(f"run written to {args.out}/ (model.npz/json, pairs.csv, poses.csv, metrics.json, paths.png)")
     return 0
 
 
@@ -178,6 +189,18 @@ def build_parser() -> argparse.ArgumentParser:
     ds.add_argument("--quiet", action="store_true")
     add_run_options(ds)
     ds.set_defaults(func=_dvbf, out_dir=lambda a: Path(a.out))
+    dn = vsub.add_parser("navigate", help="hybrid A* in a learned DVBF-LM, executed in the maze, against planning "
+                                          "in the true simulator")
+    dn.add_argument("--maze", type=int, default=1, help="maze seed (default: 1)")
+    dn.add_argument("--pairs", type=positive_int, default=40,
+                    help="seeded subset of the 600 ordered pairs of the 5 x 5 pose grid (default: 40)")
+    dn.add_argument("--model", default=None,
+                    help="a 'cogmap dvbf slam' run directory to plan in (default: learn the map with known poses)")
+    dn.add_argument("--seed", type=int, default=0, help="pose headings, pair subset and training seed (default: 0)")
+    dn.add_argument("--out", default="runs/dvbf-navigate", help="run directory (default: runs/dvbf-navigate)")
+    dn.add_argument("--quiet", action="store_true")
+    add_run_options(dn)
+    dn.set_defaults(func=_dvbf_navigate, out_dir=lambda a: Path(a.out))
 
     from .study.runner import build_parser as study_arguments
 

@@ -78,6 +78,26 @@ class MazeSim:
         hit, dist = self._cast(pose[:2], pose[2] + self.beam_angles, self.lidar_range)
         return np.where(hit, dist, self.lidar_range)
 
+    def lidar_batch(self, poses, chunk: int = 8000) -> np.ndarray:
+        """Ranges ``(K, n_beams)`` at poses ``(K, 3)``, cast in batches of at most ``chunk`` rays."""
+        poses = np.asarray(poses, float).reshape(-1, 3)
+        origins = np.repeat(poses[:, :2], self.n_beams, axis=0)
+        angles = (poses[:, 2:3] + self.beam_angles).ravel()
+        out = np.empty(len(angles))
+        for a in range(0, len(angles), chunk):
+            hit, dist = self._cast_many(origins[a:a + chunk], angles[a:a + chunk], self.lidar_range)
+            out[a:a + chunk] = np.where(hit, dist, self.lidar_range)
+        return out.reshape(len(poses), self.n_beams)
+
+    def _cast_many(self, origins, angles, length):
+        p = self._p
+        c, s = np.cos(angles), np.sin(angles)
+        z = np.full_like(c, RAY_Z)
+        frm = np.stack([origins[:, 0], origins[:, 1], z], 1)
+        to = np.stack([origins[:, 0] + length * c, origins[:, 1] + length * s, z], 1)
+        out = p.rayTestBatch(frm.tolist(), to.tolist(), physicsClientId=self.client)
+        return np.array([o[0] >= 0 for o in out]), np.array([o[2] for o in out]) * float(length)
+
     def free_distance(self, xy, heading: float, length: float) -> float:
         """How far the point can move from ``xy`` along ``heading`` (at most ``length``)."""
         if length <= 0:

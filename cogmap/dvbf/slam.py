@@ -72,11 +72,11 @@ def path_integration(start, controls) -> np.ndarray:
     return np.array(poses)
 
 
-def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: int = 32,
-                      learning_rate: float = 1e-2, seed: int = 0):
-    """Emission network trained (with a map of its own, then discarded) on a traversal with known
-    poses, such as a first maze that is not used for evaluation (the paper pretrains its transition
-    this way, Section IV). Returns ``(emission, losses)``."""
+def fit_known_poses(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: int = 32,
+                    learning_rate: float = 1e-2, seed: int = 0, emission=None):
+    """q(M) and the emission network fit by the ELBO to a traversal with known poses (each time step's
+    only particle is its true pose). With ``emission`` given, that network is kept fixed and only q(M)
+    is learnt. Returns ``(params, losses)``."""
     import jax
     import jax.numpy as jnp
 
@@ -84,6 +84,8 @@ def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: i
 
     poses, scans = jnp.asarray(np.asarray(poses, float))[:, None, :], jnp.asarray(np.asarray(scans, float))
     params = init_params(cfg, jax.random.PRNGKey(seed))
+    if emission is not None:
+        params = params._replace(emission=emission)
     opt = make_optimizer(learning_rate)
     state = init_opt_state(opt, params)
     step = make_train_step(cfg, opt, scans.shape[0])
@@ -91,9 +93,19 @@ def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: i
     losses = []
     for i in range(iters):
         idx = rng.integers(0, scans.shape[0], batch)
-        params, state, terms = step(params, state, jax.random.PRNGKey(i), Batch(poses[idx], scans[idx]))
+        new, state, terms = step(params, state, jax.random.PRNGKey(i), Batch(poses[idx], scans[idx]))
+        params = new if emission is None else new._replace(emission=emission)
         losses.append(float(terms.loss))
-    return params.emission, np.array(losses)
+    return params, np.array(losses)
+
+
+def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: int = 32,
+                      learning_rate: float = 1e-2, seed: int = 0):
+    """Emission network trained (with a map of its own, then discarded) on a traversal with known
+    poses, such as a first maze that is not used for evaluation (the paper pretrains its transition
+    this way, Section IV). Returns ``(emission, losses)``."""
+    params, losses = fit_known_poses(poses, scans, cfg, iters, batch, learning_rate, seed)
+    return params.emission, losses
 
 
 def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emission=None) -> SLAMResult:

@@ -502,6 +502,15 @@ def _drone_report(study_dir: Path, plan, results) -> str:
 REPORTS["drone"] = _drone_report
 
 
+def _dvbf_navigation_report(study_dir: Path, plan, results) -> str:
+    from .dvbf_navigation import nav_report
+
+    return nav_report(study_dir, plan, results)
+
+
+REPORTS["dvbf-navigation"] = _dvbf_navigation_report
+
+
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
     study_dir = Path(study_dir)
     body = REPORTS[name](study_dir, plan, results)

@@ -346,9 +346,15 @@ def run_drone(spec) -> dict:
     return run(spec)
 
 
+def run_dvbf_navigation(spec) -> dict:
+    from .dvbf_navigation import run_navigation
+
+    return run_navigation(spec)
+
+
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
            "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
-           "drone": run_drone}
+           "drone": run_drone, "dvbf-navigation": run_dvbf_navigation}
 
 
 _DIGEST: str | None = None
