@@ -73,6 +73,12 @@ def api_page(title: str, package: str, folder: Path) -> str:
     return "\n".join(lines)
 
 
+# Built when MkDocs loads this hook, before the plugins are configured: mkdocstrings checks its
+# search paths at that point and would fall back to the repository root (where ``cogmap/`` has no
+# ``genmodel``) on a fresh clone. ``on_config`` rebuilds it for every build of ``mkdocs serve``.
+build_tree()
+
+
 def on_config(config, **kwargs):
     build_tree()
     return config
