@@ -13,8 +13,8 @@ class AgentConfig:
 
     Lengths are in metres, angles in radians, scores in nats unless said otherwise. Table 6
     (Appendix A.1) gives the headings, influence radius, lookahead nodes, SSIM threshold and MCTS
-    depth and runs; Table 7 the transition learning rates; A.1.2 the confidence threshold. The
-    other fields are choices of this implementation (the paper leaves them open) and say so.
+    depth and runs; Table 7 the transition learning rates; A.1.2 the confidence threshold. Fields
+    that cite no table are choices of this implementation (the paper leaves them open).
 
     Attributes
     ----------
@@ -37,9 +37,9 @@ class AgentConfig:
         At most this many new states are created per expansion, i.e. per arrival at a state
         (Table 6: 8).
     ssim_threshold : float
-        In [0, 1]. Place recognition: a panorama whose best SSIM against the stored views is at
-        least this is the same observation (Table 6: 65 %); also the bar a goal image must pass
-        (:func:`cogmap.goal.goal_observation`).
+        In [0, 1]. Place recognition by the SSIM encoder: a panorama whose best SSIM against the
+        stored views is at least this is the same observation (Table 6: 65 %); also the bar a
+        goal image must pass (:func:`cogmap.goal.goal_observation`).
     encoder : str
         Name of the observation encoder (see :func:`cogmap.agent.encoder.register_encoder`);
         ``"ssim"``, the paper's, by default.
@@ -59,7 +59,8 @@ class AgentConfig:
     goal_weight : float
         Weight of the preference on the goal observation in goal mode (section 4.4).
     gamma : float
-        Precision of the softmax over the MCTS root values that picks the action (Eq. 4).
+        Policy precision (Eq. 4): precision of the softmax over the MCTS root values
+        (``MCTSConfig.gamma``).
     pose_sigma : float or None
         Metres. Width of the pose likelihood A_p and of the Eq. (7) kernel; None means
         ``influence_radius / 3`` (see :attr:`sigma`).
@@ -83,7 +84,8 @@ class AgentConfig:
         Twice this marks a state whose observation column has been taught (visited).
     obs_learning_rate : float
         Counts added to A_o when an observation is tied to a state (Eq. 8; under the posterior
-        when unsure between nearby states).
+        when unsure between nearby states). Table 6 lists a learning rate of 1; 4 is used here so
+        that a familiar view stands out enough for the conflict score of the lost test.
     relocalise_ssim : float
         In [0, 1]. Without a LiDAR scan: a recognised view at least this similar re-localises the
         belief frame onto its state's stored pose.
@@ -113,8 +115,9 @@ class AgentConfig:
     min_correction_yaw : float
         Radians; see ``min_correction``.
     lost_slack : float
-        Nats of conflict tolerated per step by the CUSUM lost test; a conflict above it on a
-        view the LiDAR disputes counts as aliasing, not as evidence of being lost.
+        Nats of conflict tolerated per step by the CUSUM lost test (:func:`cogmap.agent.confidence.cusum`);
+        a conflict above it while the LiDAR scan matches the believed place counts as aliasing,
+        not as evidence of being lost.
     view_weighting : bool
         Exploration that knows what the LiDAR has sensed (docs/exploration.md): weight each
         state's information gain by the unseen part of its view and pull toward informative
@@ -129,8 +132,8 @@ class AgentConfig:
         Square metres unseen below which a state no longer promises information (also the gain
         given to states whose believed transitions the latest scan shows blocked).
     view_frontier_spacing : float
-        Metres: frontier points are kept one per square of this side, used when no state
-        promises information.
+        Metres: frontier points of the sensed grid are taken one per square of this side; an
+        unvisited state near one promises what its view would reveal.
     view_frontier_area : float
         Square metres that must be unseen from a frontier point for it to count.
     view_spent_radius : float
