@@ -84,8 +84,8 @@ class AgentConfig:
         Twice this marks a state whose observation column has been taught (visited).
     obs_learning_rate : float
         Counts added to A_o when an observation is tied to a state (Eq. 8; under the posterior
-        when unsure between nearby states). Table 6 lists a learning rate of 1; 4 is used here so
-        that a familiar view stands out enough for the conflict score of the lost test.
+        when unsure between nearby states). Table 6 lists a learning rate of 1; this implementation
+        uses 4, chosen so that the lost test (A.1.2) is usable.
     relocalise_ssim : float
         In [0, 1]. Without a LiDAR scan: a recognised view at least this similar re-localises the
         belief frame onto its state's stored pose.
