@@ -200,8 +200,33 @@ class _Reader:
 
 
 def save_checkpoint(directory: Path, state: dict) -> Path:
-    """Write ``state`` (a dict of named parts) as a checkpoint directory, atomically: the previous
-    checkpoint is replaced only once the new one is complete."""
+    """Write ``state`` as a checkpoint directory, atomically.
+
+    The checkpoint is written to ``<directory>.new`` first; the previous checkpoint is moved to
+    ``<directory>.old`` and removed only once the new one is in place, so a write cut short
+    leaves a complete checkpoint behind (:func:`find_checkpoint`).
+
+    Parameters
+    ----------
+    directory : pathlib.Path
+        Checkpoint directory (created, or replaced when it exists).
+    state : dict
+        Named parts (string keys) of the state; each value is written with the codec of the
+        module docstring (plain values, containers, numpy scalars and arrays of bool, integer,
+        float or string dtype, generators, models, module-level cogmap functions and instances of
+        cogmap classes).
+
+    Returns
+    -------
+    pathlib.Path
+        ``directory``.
+
+    Raises
+    ------
+    CheckpointError
+        When a value cannot be written (a foreign object, a lambda, an unsupported dtype), naming
+        where it sits in ``state``.
+    """
     directory = Path(directory)
     tmp = directory.with_name(directory.name + ".new")
     if tmp.exists():
@@ -223,7 +248,19 @@ def save_checkpoint(directory: Path, state: dict) -> Path:
 
 
 def find_checkpoint(directory: Path) -> Path | None:
-    """The complete checkpoint at ``directory`` (or the previous one, if a write was cut short)."""
+    """The complete checkpoint at ``directory`` (or the previous one, if a write was cut short).
+
+    Parameters
+    ----------
+    directory : pathlib.Path
+        Checkpoint directory as given to :func:`save_checkpoint`.
+
+    Returns
+    -------
+    pathlib.Path or None
+        ``directory`` when it holds ``state.json`` and ``arrays.npz``, else ``<directory>.old``
+        when that does, else None.
+    """
     directory = Path(directory)
     for d in (directory, directory.with_name(directory.name + ".old")):
         if (d / STATE).is_file() and (d / ARRAYS).is_file():
@@ -232,7 +269,28 @@ def find_checkpoint(directory: Path) -> Path | None:
 
 
 def load_checkpoint(directory: Path) -> dict:
-    """The state written by :func:`save_checkpoint`."""
+    """The state written by :func:`save_checkpoint`.
+
+    Only classes and functions defined in ``cogmap`` are rebuilt (instances without calling their
+    ``__init__``); shared references are shared again; nothing is unpickled.
+
+    Parameters
+    ----------
+    directory : pathlib.Path
+        A complete checkpoint directory (see :func:`find_checkpoint`).
+
+    Returns
+    -------
+    dict
+        The named parts, as they were saved.
+
+    Raises
+    ------
+    CheckpointError
+        When ``state.json`` or ``arrays.npz`` cannot be read, the tree is malformed, or it refers
+        to a class or function outside cogmap. The model's own loader
+        (:func:`cogmap.genmodel.io.load`) raises its own errors on a damaged model.
+    """
     directory = Path(directory)
     try:
         tree = json.loads((directory / STATE).read_text())

@@ -22,7 +22,25 @@ from .explore import episode_metrics, make_sim, run_agent, write_run
 
 
 def astar_length(grid, start_xy, goal_xy, robot_radius: float) -> float:
-    """Shortest collision-free path length (m) for a disc robot on the occupancy grid."""
+    """Shortest collision-free path length for a disc robot on the occupancy grid.
+
+    The reference of the goal study's path ratio (section 4.4: executed path over the A* optimum).
+
+    Parameters
+    ----------
+    grid : cogmap.envs.occupancy.OccupancyGrid
+        The world's occupancy grid (ground truth).
+    start_xy, goal_xy : array_like
+        ``(2,)`` (or longer: only x, y are read) world positions, metres.
+    robot_radius : float
+        Robot radius, metres; obstacles are inflated by 0.9 of it.
+
+    Returns
+    -------
+    float
+        8-connected A* path length, metres; ``inf`` when there is no path (or an end cell is
+        occupied or outside the grid).
+    """
     from cogmap.planning.astar import astar_grid
 
     blocked = grid.inflated(robot_radius * 0.9)
@@ -32,7 +50,32 @@ def astar_length(grid, start_xy, goal_xy, robot_radius: float) -> float:
 
 
 def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
-    """Rebuild an agent (model, observations, config) from a run directory."""
+    """Rebuild an agent (model, observations, config) from a run directory.
+
+    Reads ``run.json`` (the config), the observation images of ``observations/`` (added to a
+    fresh encoder of the run's kind, in file order), ``model/`` and, when present,
+    ``anchors.npz`` (the drift-correction anchors).
+
+    Parameters
+    ----------
+    run : pathlib.Path
+        Run directory written by ``cogmap explore`` (:func:`cogmap.explore.write_run`).
+    seed : int, optional
+        Seed of the rebuilt agent's RNG, default 0.
+
+    Returns
+    -------
+    agent : cogmap.agent.aimapp.AIMAPPAgent
+        The agent with the run's config, encoder, model and anchors (beliefs not set).
+    manifest : dict
+        The run's ``run.json``.
+
+    Raises
+    ------
+    ValueError
+        When the run's encoder has no ``add(image)`` method (register custom encoders before
+        loading), or the number of observation images differs from the model's outcomes.
+    """
     import cv2
 
     from cogmap.genmodel.io import load
@@ -55,7 +98,26 @@ def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
 
 
 def goal_observation(agent: AIMAPPAgent, image: np.ndarray) -> int:
-    """Id of the stored observation matching ``image``; a clear error when none matches."""
+    """Id of the stored observation matching ``image``.
+
+    Parameters
+    ----------
+    agent : cogmap.agent.aimapp.AIMAPPAgent
+        An agent whose encoder holds the observations (e.g. from :func:`load_agent`).
+    image : numpy.ndarray
+        Goal panorama, ``(H, W, 3)`` uint8 RGB, as the agent's encoder takes it.
+
+    Returns
+    -------
+    int
+        The observation id the encoder matches best.
+
+    Raises
+    ------
+    ValueError
+        When no observation matches, or the best score is below ``agent.cfg.ssim_threshold``
+        (Table 6).
+    """
     best, score = agent.encoder.match(image)
     if best < 0 or score < agent.cfg.ssim_threshold:
         raise ValueError(f"goal image not recognised (best SSIM {score:.2f} < {agent.cfg.ssim_threshold})")
@@ -63,8 +125,31 @@ def goal_observation(agent: AIMAPPAgent, image: np.ndarray) -> int:
 
 
 def pursue(sim, agent: AIMAPPAgent, goal_obs: int, steps: int, progress: bool = True):
-    """Run goal mode from the robot's current place until the goal is observed; returns the
-    episode and summary (reached, path length, A* length, ratio)."""
+    """Run goal mode from the robot's current place until the goal is observed (section 4.4).
+
+    Parameters
+    ----------
+    sim : cogmap.envs.NavSim
+        The simulator, with the robot where the goal run starts.
+    agent : cogmap.agent.aimapp.AIMAPPAgent
+        A localised agent with a learnt model (:meth:`AIMAPPAgent.localise_at`).
+    goal_obs : int
+        Observation id to reach (set as the agent's goal).
+    steps : int
+        Largest number of decisions.
+    progress : bool, optional
+        Show a progress bar, default True.
+
+    Returns
+    -------
+    episode : cogmap.harness.Episode
+        The run's record.
+    summary : dict
+        ``reached`` (the agent confidently observes the goal), ``steps``, ``executed_m`` (true
+        distance driven, metres), ``astar_m`` (:func:`astar_length` from the start to where the
+        robot stopped, metres), ``path_ratio`` (executed / A*, None when the A* length is 0 or
+        infinite) and ``goal_obs``.
+    """
     agent.set_goal(goal_obs)
     start = sim.true_pose()[:2].copy()
     ep = run_agent(sim, agent, steps, progress, stop=lambda d: agent.at_goal, desc="goal")
@@ -84,7 +169,42 @@ def pursue(sim, agent: AIMAPPAgent, goal_obs: int, steps: int, progress: bool = 
 
 def reach_goal(run: Path, goal_image: str | None = None, goal_obs: int | None = None, steps: int = 60,
                seed: int = 0, out: Path | None = None, progress: bool = True) -> dict:
-    """``cogmap goal``: start where the exploration started, knowing it (section 4.1 protocol)."""
+    """``cogmap goal``: start where the exploration started, knowing it (section 4.1 protocol).
+
+    Rebuilds the agent from ``run`` (:func:`load_agent`), recreates the run's world with its seed
+    and odometry noise, localises the agent at the start pose, runs :func:`pursue` and writes a
+    run directory (manifest, model, trajectory, figures) to ``out``.
+
+    Parameters
+    ----------
+    run : pathlib.Path
+        Exploration run directory.
+    goal_image : str or None, optional
+        Path of the goal image; recognised with :func:`goal_observation`.
+    goal_obs : int or None, optional
+        Observation id of the goal, used when ``goal_image`` is None. Give one of the two.
+    steps : int, optional
+        Largest number of decisions, default 60.
+    seed : int, optional
+        Seed of the agent's RNG, default 0 (the world uses the run's own seed).
+    out : pathlib.Path or None, optional
+        Output directory, default ``run / "goal"``.
+    progress : bool, optional
+        Show a progress bar, default True.
+
+    Returns
+    -------
+    dict
+        The episode metrics (:func:`cogmap.explore.episode_metrics`: coverage, distance_m,
+        decision times, ...) merged with the :func:`pursue` summary (reached, executed_m,
+        astar_m, path_ratio, ...).
+
+    Raises
+    ------
+    ValueError
+        When the goal image cannot be read or is not recognised, the goal id is unknown, or the
+        run cannot be rebuilt (see :func:`load_agent`).
+    """
     import cv2
 
     from .runs import write_manifest

@@ -39,7 +39,17 @@ class RunFailed(RuntimeError):
 
 
 def add_run_options(parser, resume_help: str | None = None) -> None:
-    """``--time-limit``, ``--force`` and ``--resume`` (``resume_help`` None: refused when given)."""
+    """Add ``--time-limit``, ``--force`` and ``--resume`` to a command's parser.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The command's (sub)parser; it also gets the default ``resumable`` (whether ``resume_help``
+        was given), read by :func:`run_command`.
+    resume_help : str or None, optional
+        Help text of ``--resume`` for a command that can resume a run; None (default): the
+        command cannot, and ``--resume`` is refused with a message when given.
+    """
     parser.add_argument("--time-limit", type=nonnegative_float, default=DEFAULT_TIME_LIMIT_S, metavar="SECONDS",
                         help=f"stop the run after this many seconds of wall-clock time, keep what it wrote and "
                              f"record the reason in {FAILED} (default: {DEFAULT_TIME_LIMIT_S:g}; 0: no limit)")
@@ -58,7 +68,29 @@ def _protected(path: Path) -> bool:
 
 
 def prepare_out(out: Path | None, command: str, force: bool, resume: bool, resumable: bool) -> None:
-    """Check (and with ``force`` clear) the run directory before anything runs."""
+    """Check (and with ``force`` clear) the run directory before anything runs.
+
+    Parameters
+    ----------
+    out : pathlib.Path or None
+        The run directory; None when the command writes none (only the flags are checked).
+    command : str
+        Command name, for the messages.
+    force : bool
+        Clear a non-empty directory (never the root, the home directory, the working directory or
+        one of its parents).
+    resume : bool
+        Continue the run the directory holds: it must not be empty; its ``failed.json`` is removed.
+    resumable : bool
+        Whether the command supports ``resume``.
+
+    Raises
+    ------
+    RunDirError
+        On ``resume`` for a command that cannot resume, ``resume`` with ``force``, ``out`` that is
+        a file, nothing to resume, a non-empty directory without ``force`` or ``resume``, or a
+        protected directory to clear.
+    """
     if resume and not resumable:
         raise RunDirError(f"--resume is not supported by {command}; start again with --force")
     if resume and force:
@@ -89,7 +121,23 @@ def prepare_out(out: Path | None, command: str, force: bool, resume: bool, resum
 
 
 def write_failed(out: Path | None, command: str, reason: str, **fields) -> None:
-    """``failed.json`` in the run directory: why the run stopped (what was written is kept)."""
+    """Write ``failed.json`` in the run directory: why the run stopped (what was written is kept).
+
+    Parameters
+    ----------
+    out : pathlib.Path or None
+        The run directory (created if missing); None: nothing is written.
+    command : str
+        Command name.
+    reason : str
+        Why the run stopped, one line.
+    **fields
+        Further JSON-serialisable entries (e.g. ``time_limit_s``).
+
+    Notes
+    -----
+    The record also holds the UTC time it was written (``time``, ISO 8601).
+    """
     if out is None:
         return
     out.mkdir(parents=True, exist_ok=True)
@@ -122,7 +170,38 @@ def _child(spec: dict) -> dict:
 
 
 def run_command(args, command: str, out: Path | None) -> int:
-    """Prepare the run directory, then run ``args.func(args)`` under the time limit."""
+    """Prepare the run directory, then run ``args.func(args)`` under the time limit.
+
+    Calls ``args.precheck(args)`` when the parser set one, then :func:`prepare_out`. Without a
+    limit (0) or with ``--debug`` the command runs in this process; otherwise in a supervised
+    child (:func:`cogmap.study.supervisor.run_one`) whose captured stdout is echoed here.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        Parsed arguments with ``func``, ``time_limit`` (seconds), ``force``, ``resume`` and
+        ``resumable`` (see :func:`add_run_options`); optionally ``debug``, ``precheck`` and
+        ``plugin`` (modules imported in the child too).
+    command : str
+        Command name, for messages and ``failed.json``.
+    out : pathlib.Path or None
+        The run directory, or None when the command writes none.
+
+    Returns
+    -------
+    int
+        The command's exit status (what ``args.func`` returned).
+
+    Raises
+    ------
+    RunDirError
+        From :func:`prepare_out`.
+    RunFailed
+        When the supervised command raised (recorded in ``failed.json`` if the run directory has
+        content), exceeded the limit or died (always recorded); the message says what was kept.
+    KeyboardInterrupt
+        Re-raised after recording the interruption in ``failed.json``.
+    """
     from .study.supervisor import run_one
 
     check = getattr(args, "precheck", None)

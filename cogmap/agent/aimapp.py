@@ -49,7 +49,28 @@ from .viewmap import ViewMap
 
 @dataclass
 class Sensed:
-    """What the robot reports at one step; ``None`` marks a stream that did not report."""
+    """What the robot reports at one step; ``None`` marks a stream that did not report.
+
+    The agent turns panorama, obstacle flags and scan into its belief frame before using them.
+
+    Attributes
+    ----------
+    panorama : numpy.ndarray or None
+        360-degree camera image, ``(H, W, 3)`` uint8 RGB (any image the encoder takes); None
+        while the camera is silent.
+    obstacles : numpy.ndarray or None
+        ``(num_headings,)`` bool, one per heading (odometry frame): an obstacle lies within the
+        move's corridor; None while the LiDAR is silent.
+    odometry : numpy.ndarray or None
+        ``(3,)`` float odometry pose ``(x, y, yaw)``, metres and radians; None while odometry is
+        silent.
+    moved : bool or None
+        Outcome of the last motion command (False: the controller reported it blocked); None when
+        no command was given.
+    scan : numpy.ndarray or None
+        ``(n, 2)`` float LiDAR returns relative to the robot, metres, axes of the odometry frame;
+        optional (None: no scan, only the obstacle flags).
+    """
 
     panorama: np.ndarray | None
     obstacles: np.ndarray | None  # one bool per heading: obstacle within reach
@@ -67,6 +88,32 @@ class Sensed:
 
 @dataclass
 class Decision:
+    """What one :meth:`AIMAPPAgent.step` decided.
+
+    Attributes
+    ----------
+    action : int
+        Control index: a heading ``0 .. num_headings - 1`` or ``num_headings`` (stay).
+    waypoint : numpy.ndarray
+        ``(2,)`` float where to drive, metres, odometry frame.
+    state : int
+        Most probable current state (-1 while paused before any decision).
+    target : int
+        State the move is expected to reach (== ``state`` for stay or a direction with no state).
+    mode : str
+        ``"explore"``, ``"goal"``, ``"relocalise"`` (lost) or ``"paused"`` (odometry silent).
+    confidence : cogmap.agent.confidence.Confidence or None
+        The confidence test of this step (A.1.2); None when paused.
+    expanded : int
+        Number of states the map gained this step (Eq. 7 expansion).
+    efe : dict
+        The planner's summary when MCTS ran (root ``actions``, values ``Q`` and ``visits``, the
+        ``objective``, the planning ``arrays``, the ``obstacles`` flags and, while a view-weighted
+        target is pursued, the ``preferred`` states); empty otherwise.
+    missing : tuple of str
+        Streams that did not report at this step (see :attr:`Sensed.missing`).
+    """
+
     action: int
     waypoint: np.ndarray  # odometry frame
     state: int
@@ -79,7 +126,25 @@ class Decision:
 
 
 def initial_model(cfg: AgentConfig, pose0) -> Model:
-    """One state at the start pose, one observation slot, nothing learnt."""
+    """One state at the start pose, one observation slot, nothing learnt (section 3.1).
+
+    A single growable ``place`` factor with ``cfg.num_actions`` controls (stay last, B_s says
+    every control stays), a growable ``view`` modality A_o with ``prior_count`` mass, the pose
+    likelihood A_p (state poses, headings, step ``influence_radius``, width ``cfg.sigma``) and
+    the inductive term's settings (Eq. 9).
+
+    Parameters
+    ----------
+    cfg : AgentConfig
+        The agent's parameters.
+    pose0 : array_like
+        Start position ``(x, y)`` (a longer pose: only x, y are read), metres, belief frame.
+
+    Returns
+    -------
+    cogmap.genmodel.Model
+        The compiled model, capacity ``cfg.initial_capacity`` states and observations.
+    """
     u = cfg.num_actions
     headings = 2 * np.pi * np.arange(cfg.num_headings) / cfg.num_headings
     succ = np.zeros((1, u, 2), dtype=int)
@@ -98,7 +163,54 @@ def initial_model(cfg: AgentConfig, pose0) -> Model:
 
 
 class AIMAPPAgent:
-    """Owns the model, beliefs, pose correction, encoder and RNG; contains no maths."""
+    """Owns the model, beliefs, pose correction, encoder and RNG; contains no maths.
+
+    The model is created at the first :meth:`step` (one state at the first believed pose) unless
+    one is given (a learnt model, e.g. for goal reaching).
+
+    Parameters
+    ----------
+    config : AgentConfig or None, optional
+        The agent's parameters; None (default) for the paper's defaults.
+    encoder : Encoder or None, optional
+        Observation encoder; None (default) builds the one named by ``config.encoder``.
+    seed : int, optional
+        Seed of the agent's RNG (MCTS, moves while lost), default 0.
+    model : cogmap.genmodel.Model or None, optional
+        A model to start from; None (default): built at the first step.
+
+    Attributes
+    ----------
+    cfg : AgentConfig
+        The parameters.
+    encoder : Encoder
+        Image -> observation id.
+    model : cogmap.genmodel.Model or None
+        The generative model (None before the first step).
+    q : numpy.ndarray or None
+        ``(num_states,)`` posterior over states after the last step.
+    frame : cogmap.inference.se2.SE2
+        Odometry frame -> belief frame (drift correction, section 3.3).
+    anchors : dict of int to Anchor
+        State -> view and scan of its first confident visit (drift correction).
+    last : Decision or None
+        The last decision.
+    goal_obs : int or None
+        The preferred observation in goal mode (None: exploring).
+    lost : bool
+        The lost test fired and the agent is re-localising.
+    corrections, lost_events, relocalisations, step_count : int
+        Counters: accepted drift corrections, times lost, times found again, steps taken.
+    views : ViewMap
+        What the LiDAR has sensed (exploration planning).
+
+    Raises
+    ------
+    KeyError
+        When ``config.encoder`` names no registered encoder.
+    TypeError
+        When the encoder does not follow the :class:`Encoder` protocol.
+    """
 
     def __init__(self, config: AgentConfig | None = None, encoder: Encoder | None = None, seed: int = 0,
                  model: Model | None = None):
@@ -126,10 +238,12 @@ class AIMAPPAgent:
     # -- public ------------------------------------------------------------------------------
     @property
     def num_states(self) -> int:
+        """Number of live states of the map (0 before the first step)."""
         return 0 if self.model is None else self.model.num_states[0]
 
     @property
     def poses(self) -> np.ndarray:
+        """``(num_states, 2)`` float stored state positions, metres, belief frame."""
         return self.model.pose.poses[: self.num_states]
 
     @property
@@ -138,15 +252,48 @@ class AIMAPPAgent:
         return self.frame.t
 
     def believed_pose(self, odometry) -> np.ndarray:
-        """Believed (x, y) of an odometry pose (``frame`` applied)."""
+        """Believed (x, y) of an odometry pose (``frame`` applied).
+
+        Parameters
+        ----------
+        odometry : array_like
+            Odometry pose ``(x, y[, yaw])``, metres; only x, y are read.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float position, metres, belief frame.
+        """
         return apply(self.frame, np.asarray(odometry, dtype=float)[:2])
 
     def believed_pose_yaw(self, odometry) -> np.ndarray:
-        """Believed (x, y, yaw) of an odometry pose (x, y, yaw)."""
+        """Believed (x, y, yaw) of an odometry pose (x, y, yaw).
+
+        Parameters
+        ----------
+        odometry : array_like
+            ``(3,)`` odometry pose, metres and radians (a ``(2,)`` position gives a position).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(3,)`` float pose in the belief frame, yaw wrapped to [-pi, pi).
+        """
         return apply_pose(self.frame, odometry)
 
     def to_odometry(self, xy) -> np.ndarray:
-        """A belief-frame point in the odometry frame (where the simulator drives)."""
+        """A belief-frame point in the odometry frame (where the simulator drives).
+
+        Parameters
+        ----------
+        xy : array_like
+            ``(..., 2)`` points, metres, belief frame.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(..., 2)`` float points, metres, odometry frame.
+        """
         return apply(invert(self.frame), xy)
 
     def _shift_frame(self, delta) -> None:
@@ -161,7 +308,21 @@ class AIMAPPAgent:
                 and last.confidence is not None and last.confidence.confident)
 
     def localise_at(self, odometry) -> int:
-        """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``."""
+        """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``.
+
+        The posterior becomes one-hot on that state, the belief frame is shifted so the believed
+        pose is the state's stored pose, and the last decision is forgotten.
+
+        Parameters
+        ----------
+        odometry : array_like
+            Current odometry pose ``(x, y[, yaw])``, metres.
+
+        Returns
+        -------
+        int
+            The state now believed.
+        """
         s, _ = self.model.pose_index().nearest(self.believed_pose(odometry))
         self.q = np.zeros(self.num_states)
         self.q[s] = 1.0
@@ -170,8 +331,19 @@ class AIMAPPAgent:
         return s
 
     def set_goal(self, obs: int | None) -> None:
-        """Prefer observation ``obs`` (goal mode: C puts log-preference 1 on it, weighted by the
-        goal weight when planning), or return to exploration with ``None``."""
+        """Prefer observation ``obs`` (goal mode, section 4.4), or return to exploration with ``None``.
+
+        Parameters
+        ----------
+        obs : int or None
+            Observation id of the goal: C puts log-preference 1 on it (0 elsewhere), weighted by
+            ``cfg.goal_weight`` when planning. None clears the preference.
+
+        Raises
+        ------
+        ValueError
+            When ``obs`` is not a known observation id.
+        """
         if obs is not None and not 0 <= obs < self.model.num_obs[0]:
             raise ValueError(f"goal observation {obs} is unknown (have {self.model.num_obs[0]})")
         self.goal_obs = obs
@@ -180,14 +352,40 @@ class AIMAPPAgent:
             self.model.C[0][obs] = 1.0
 
     def goal_states(self, min_prob: float = 0.5) -> np.ndarray:
-        """States whose observation model favours the goal observation."""
+        """States whose observation model favours the goal observation.
+
+        Parameters
+        ----------
+        min_prob : float, optional
+            A state counts when ``A_o[goal, s]`` is at least this fraction of the largest entry
+            of that row (and at least 1e-9), default 0.5.
+
+        Returns
+        -------
+        numpy.ndarray
+            Int state indices, ascending; empty without a goal.
+        """
         if self.goal_obs is None:
             return np.zeros(0, dtype=int)
         row = self.model.A_row(0, self.goal_obs)
         return np.flatnonzero(row >= max(min_prob * row.max(), 1e-9))
 
     def step(self, sensed: Sensed) -> Decision:
-        """One sense -> infer -> learn -> plan cycle; returns where to go next."""
+        """One sense -> infer -> learn -> plan cycle (sections 3.1-3.6, see the module docstring).
+
+        Parameters
+        ----------
+        sensed : Sensed
+            What the robot reports now (odometry frame); ``moved`` is the outcome of the command
+            of the previous decision.
+
+        Returns
+        -------
+        Decision
+            Where to go next (waypoint in the odometry frame) and why; mode ``"paused"`` (stay,
+            nothing changed) while odometry is silent, or before the model exists while any
+            stream is.
+        """
         self.step_count += 1
         if self.last is not None and self._outcome is None and sensed.moved is not None:
             self._outcome = bool(sensed.moved)  # outcome of the last real motion command
@@ -379,13 +577,26 @@ class AIMAPPAgent:
 
     def scanned_from(self) -> np.ndarray:
         """Mask of states the agent has stood on with its LiDAR reporting: what their view can
-        reveal has been seen (a state passed while the LiDAR was silent still promises it)."""
+        reveal has been seen (a state passed while the LiDAR was silent still promises it).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(num_states,)`` bool.
+        """
         mask = np.zeros(self.num_states, dtype=bool)
         mask[list(self.scanned)] = True
         return mask
 
     def visited(self) -> np.ndarray:
-        """Mask of states whose observation model has been taught (the agent has been there)."""
+        """Mask of states whose observation model has been taught (the agent has been there).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(num_states,)`` bool: the largest count of the state's A_o column exceeds
+            ``2 * prior_count``.
+        """
         return self.model.A[0].taught(2 * self.cfg.prior_count)
 
     def _scan_agrees(self, sensed: Sensed, pose: np.ndarray) -> bool:

@@ -9,6 +9,157 @@ from cogmap.inference.learning import LearningRates
 
 @dataclass(frozen=True)
 class AgentConfig:
+    """Every parameter of the AIMAPP agent, with the paper's defaults (frozen; change with ``replace``).
+
+    Lengths are in metres, angles in radians, scores in nats unless said otherwise. Table 6
+    (Appendix A.1) gives the headings, influence radius, lookahead nodes, SSIM threshold and MCTS
+    depth and runs; Table 7 the transition learning rates; A.1.2 the confidence threshold. Fields
+    that cite no table are choices of this implementation (the paper leaves them open).
+
+    Attributes
+    ----------
+    num_headings : int
+        Number of move directions, evenly spaced over 2 pi; with the stay control the agent has
+        ``num_headings + 1`` controls (12 + 1 = 13 actions, Table 6).
+    influence_radius : float
+        Metres. Length of one move, spacing of new states and range of a state's pose kernel
+        (Table 6: 1 m in small environments, 2 m in large ones). Also the unit of the correction
+        limits below.
+    robot_radius : float
+        Metres. Physical radius of the robot (Table 6: robot-specific): with ``obstacle_margin``
+        the half-width of the corridor a move must find free of LiDAR returns (obstacle signal,
+        state creation), and the tolerance of the scan check on believed transitions.
+    node_spacing : float
+        Fraction of ``influence_radius``: the Eq. (7) expansion test scores a candidate state
+        against the nearest stored pose with a new-state kernel at ``node_spacing *
+        influence_radius``, so a predicted pose farther than about that from every node is added.
+    lookahead_nodes : int
+        At most this many new states are created per expansion, i.e. per arrival at a state
+        (Table 6: 8).
+    ssim_threshold : float
+        In [0, 1]. Place recognition by the SSIM encoder: a panorama whose best SSIM against the
+        stored views is at least this is the same observation (Table 6: 65 %); also the bar a
+        goal image must pass (:func:`cogmap.goal.goal_observation`).
+    encoder : str
+        Name of the observation encoder (see :func:`cogmap.agent.encoder.register_encoder`);
+        ``"ssim"``, the paper's, by default.
+    mcts_depth : int
+        Steps of the MCTS lookahead (Appendix A.3 and Table 6: 10).
+    mcts_simulations : int
+        MCTS simulations per decision (Appendix A.3 and Table 6: 30).
+    mcts_count_information_once : bool
+        Count epistemic value once per imagined path in MCTS (see
+        :class:`cogmap.planning.mcts.MCTSConfig`); False sums every step's EFE as in Eq. (5).
+    mcts_discount : float
+        Discount of later steps' EFE in MCTS; 1 is the plain sum of Eq. (5).
+    z_threshold : float
+        Nats. Threshold of the confidence test (A.1.2 uses 4): the agent is confident when the
+        log-odds of its most likely state against the runner-up reach it, and lost when the CUSUM
+        of the observation conflict does (:mod:`cogmap.agent.confidence`).
+    goal_weight : float
+        Weight of the preference on the goal observation in goal mode (section 4.4).
+    gamma : float
+        Policy precision (Eq. 4): precision of the softmax over the MCTS root values
+        (``MCTSConfig.gamma``).
+    pose_sigma : float or None
+        Metres. Width of the pose likelihood A_p and of the Eq. (7) kernel; None means
+        ``influence_radius / 3`` (see :attr:`sigma`).
+    obstacle_margin : float
+        Metres added to ``robot_radius`` for the half-width of the collision corridor of a move
+        (also passed to the simulator's own obstacle signal by :mod:`cogmap.explore`).
+    min_move_probability : float
+        MCTS plans a move only when the believed probability that it leaves the current state
+        exceeds this (``MCTSConfig.move_threshold``).
+    inductive_threshold : float
+        A transition counts as possible for the inductive term H when its probability in B_s
+        exceeds this (Eq. 9, A.2); the same graph gives the path lengths of the goal study.
+    inductive_depth : int
+        Steps over which H propagates the goal value back (Eq. 9), beyond the MCTS depth.
+    inductive_weight : float
+        Weight of the inductive term in goal mode (Eq. 9).
+    collision_preference : float
+        Log-preference of a collision outcome (Eq. 6), read by the planner.
+    prior_count : float
+        Dirichlet mass of a new column: spread over the outcomes for A_o, on staying for B_s.
+        Twice this marks a state whose observation column has been taught (visited).
+    obs_learning_rate : float
+        Counts added to A_o when an observation is tied to a state (Eq. 8; under the posterior
+        when unsure between nearby states). Table 6 lists a learning rate of 1; this implementation
+        uses 4, chosen so that the lost test (A.1.2) is usable.
+    relocalise_ssim : float
+        In [0, 1]. Without a LiDAR scan: a recognised view at least this similar re-localises the
+        belief frame onto its state's stored pose.
+    relocalise_align_ssim : float
+        In [0, 1]. Drift correction at a revisit (section 3.3, :mod:`cogmap.agent.correction`):
+        shift-searched SSIM needed against the state's anchor view (threshold measured in
+        ``bench/relocalisation.py``).
+    relocalise_inliers : float
+        In [0, 1]. Fraction of LiDAR returns that the aligned scans must share (within 0.1 m)
+        for a revisit correction, a re-localisation after being lost, or the scan check that
+        tells aliasing from being lost.
+    relocalise_max_shift : int
+        Panorama columns searched for the heading correction (32 = 45 degrees on 256 columns).
+    relocalise_max_correction : float
+        In influence radii: largest position correction accepted at a revisit.
+    track_anchors : bool
+        At a first visit, align the scan with the anchor of the state just left.
+    track_inliers : float
+        In [0, 1]. Fraction of shared LiDAR returns needed for that alignment.
+    track_max_correction : float
+        In influence radii: largest correction that alignment (and the aliasing scan check) may
+        make.
+    min_correction : float
+        Metres. Corrections that move the pose less than this and turn it less than
+        ``min_correction_yaw`` are left out (scan alignment between places 1-2 m apart errs by
+        about this much).
+    min_correction_yaw : float
+        Radians; see ``min_correction``.
+    lost_slack : float
+        Nats of conflict tolerated per step by the CUSUM lost test (:func:`cogmap.agent.confidence.cusum`);
+        a conflict above it while the LiDAR scan matches the believed place counts as aliasing,
+        not as evidence of being lost.
+    view_weighting : bool
+        Exploration that knows what the LiDAR has sensed (docs/exploration.md): weight each
+        state's information gain by the unseen part of its view and pull toward informative
+        states; False keeps the paper's terms only.
+    view_resolution : float
+        Metres: cell size of the agent's sensed grid.
+    view_radius : float
+        Metres: range of the view imagined from a state.
+    view_rays : int
+        Rays cast for an imagined view.
+    view_min_area : float
+        Square metres unseen below which a state no longer promises information (also the gain
+        given to states whose believed transitions the latest scan shows blocked).
+    view_frontier_spacing : float
+        Metres: frontier points of the sensed grid are taken one per square of this side; an
+        unvisited state near one promises what its view would reveal.
+    view_frontier_area : float
+        Square metres that must be unseen from a frontier point for it to count.
+    view_spent_radius : float
+        Metres: a frontier point this close to a visited state is spent.
+    view_frontier_reach : float
+        Metres (geodesic): a frontier point counts for an unvisited state that sees it this close.
+    view_detour : float
+        Metres added to the path length when scoring a target as unseen area / (path + detour),
+        as for the oracle baseline.
+    view_keep_ratio : float
+        Keep pursuing the current target while its score is at least this fraction of the best.
+    view_doubt_range : float
+        Metres: believed transitions with both ends this close to the robot are checked against
+        the latest scan.
+    view_floor : float
+        Smallest weight of a state's information gain (fraction of a full view).
+    explore_inductive_weight : float
+        Weight of the inductive term toward states that still promise information while
+        exploring.
+    learning : cogmap.inference.learning.LearningRates
+        Transition learning rates (Table 7: forward 7 / -7 / 5 / -5, reverse 5 / -5 / 3 / -3 for
+        possible / impossible / predicted possible / predicted impossible).
+    initial_capacity : int
+        Preallocated number of states and observations of the growable model (grows past it).
+    """
+
     num_headings: int = 12  # 12 headings + stay = 13 actions (Table 6)
     influence_radius: float = 1.0  # 1 m small environments, 2 m large ones (Table 6)
     robot_radius: float = 0.22  # physical radius: collision buffer for state creation
@@ -67,6 +218,7 @@ class AgentConfig:
 
     @property
     def num_actions(self) -> int:
+        """Number of controls: the headings plus stay (13 with the Table 6 default)."""
         return self.num_headings + 1
 
     @property
@@ -76,9 +228,19 @@ class AgentConfig:
 
     @property
     def sigma(self) -> float:
+        """Width (m) of the pose likelihood: ``pose_sigma``, or ``influence_radius / 3`` when unset."""
         return self.pose_sigma if self.pose_sigma is not None else self.influence_radius / 3
 
     def to_dict(self) -> dict:
+        """Every field as plain data (the learning rates as a nested dict), for manifests and JSON.
+
+        Returns
+        -------
+        dict
+            Field name -> value; ``encoder`` is left out when it is the default ``"ssim"`` (so
+            manifests and study run keys made before encoders were chosen by name stay the same;
+            :meth:`from_dict` restores it).
+        """
         d = asdict(self)
         if d["encoder"] == "ssim":
             # the paper's encoder is left implicit (from_dict restores it), so the manifests and
@@ -88,8 +250,24 @@ class AgentConfig:
 
     @classmethod
     def from_dict(cls, d: dict) -> AgentConfig:
-        """The inverse of :meth:`to_dict` (also after a JSON round trip): every field is kept,
-        the nested learning rates included; an unknown key is a clear error."""
+        """The inverse of :meth:`to_dict` (also after a JSON round trip).
+
+        Parameters
+        ----------
+        d : dict
+            Field name -> value, e.g. from :meth:`to_dict` or a run manifest; missing fields take
+            their defaults; ``learning`` may be a dict (lists become tuples).
+
+        Returns
+        -------
+        AgentConfig
+            The configuration, every field kept, the nested learning rates included.
+
+        Raises
+        ------
+        ValueError
+            On a key that is not a field (of the config or of the learning rates).
+        """
         d = dict(d)
         _check_keys(cls, d)
         if isinstance(d.get("learning"), dict):

@@ -34,6 +34,14 @@ class Encoder(Protocol):
     files; an encoder that keeps no images gives an empty sequence). ``last_scores`` are the
     similarities of the latest query to the stored observations it was compared with (empty
     when nothing was compared); the agent uses their maximum to judge how familiar a view is.
+
+    Attributes
+    ----------
+    images : sequence of numpy.ndarray
+        Stored observations in id order (e.g. ``(H, W, 3)`` uint8 RGB panoramas); may be empty.
+    last_scores : numpy.ndarray
+        ``(k,)`` float similarities of the latest query to the ``k`` stored observations it was
+        compared with (higher is more similar).
     """
 
     images: Sequence[np.ndarray]
@@ -43,11 +51,35 @@ class Encoder(Protocol):
         """Return (observation id, whether the id is new); a new id stores the image."""
 
     def match(self, image: np.ndarray) -> tuple[int, float]:
-        """Best stored id and its similarity score, storing nothing ((-1, 0.0) when empty)."""
+        """Best stored id and its similarity score, storing nothing.
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            The query image (as the encoder takes it, e.g. an ``(H, W, 3)`` RGB panorama).
+
+        Returns
+        -------
+        id : int
+            Best stored observation id; -1 when nothing is stored.
+        score : float
+            Its similarity score (0.0 when nothing is stored).
+        """
 
 
 def check_encoder(encoder) -> None:
-    """A clear error naming what an encoder lacks of the :class:`Encoder` protocol."""
+    """A clear error naming what an encoder lacks of the :class:`Encoder` protocol.
+
+    Parameters
+    ----------
+    encoder : object
+        The object to check: it needs ``images``, ``last_scores``, ``__call__`` and ``match``.
+
+    Raises
+    ------
+    TypeError
+        Naming the missing members.
+    """
     missing = [name for name in ("images", "last_scores", "__call__", "match") if not hasattr(encoder, name)]
     if missing:
         raise TypeError(f"{type(encoder).__name__} is not an Encoder: it lacks {', '.join(missing)}")
@@ -83,7 +115,23 @@ def _blur(x: np.ndarray) -> np.ndarray:
 
 
 def ssim(a: np.ndarray, b: np.ndarray) -> float:
-    """Mean structural similarity of two images (grey levels 0-255)."""
+    """Mean structural similarity of two images (Wang et al. 2004; section 3.1, Table 6).
+
+    Local means, variances and covariance use an 11 x 11 Gaussian window of sigma 1.5 (borders
+    reflected), with the constants ``C1 = (0.01 * 255)**2`` and ``C2 = (0.03 * 255)**2``.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        Images of the same size, ``(H, W)`` grey or ``(H, W, C)`` RGB(A) (turned grey with the
+        BT.601 weights), grey levels 0-255.
+
+    Returns
+    -------
+    float
+        Mean SSIM over the pixels, at most 1 (identical images); the paper's encoder treats a
+        score of at least 0.65 as the same observation.
+    """
     x, y = _gray(a), _gray(b)
     mx, my = _blur(x), _blur(y)
     vx, vy = _blur(x * x) - mx * mx, _blur(y * y) - my * my
@@ -99,7 +147,27 @@ def column_shift_scores(a: np.ndarray, b: np.ndarray, rows: int = 16) -> np.ndar
 
     Both images are reduced to ``rows`` grey rows (area average) with each row's mean removed;
     the circular cross-correlation of the rows is summed (one FFT per image), so every shift
-    costs nothing extra. Used to shortlist the shifts worth an SSIM."""
+    costs nothing extra. Used to shortlist the shifts worth an SSIM.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        Panoramas of the same shape, ``(H, W)`` grey or ``(H, W, C)`` RGB; the columns span 360
+        degrees, so one column is ``360 / W`` degrees of heading.
+    rows : int, optional
+        Number of rows the images are reduced to, default 16.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(W,)`` float correlations in [-1, 1]; entry ``s`` is for the shift ``s`` (a negative
+        shift ``-s`` is entry ``W - s``).
+
+    Raises
+    ------
+    ValueError
+        When the two images differ in shape.
+    """
     x, y = _gray(a), _gray(b)
     if x.shape != y.shape:
         raise ValueError(f"images of shapes {x.shape} and {y.shape} differ")
@@ -114,20 +182,69 @@ def column_shift_scores(a: np.ndarray, b: np.ndarray, rows: int = 16) -> np.ndar
 
 
 def signed_shifts(max_shift: int, width: int) -> np.ndarray:
-    """Column shifts ``-max_shift .. max_shift`` (clipped to half the width)."""
+    """Column shifts ``-max_shift .. max_shift`` (clipped to half the width).
+
+    Parameters
+    ----------
+    max_shift : int
+        Largest shift searched, columns.
+    width : int
+        Panorama width, columns.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(2 m + 1,)`` int shifts ``-m .. m`` with ``m = min(max_shift, width // 2)``.
+    """
     m = min(int(max_shift), width // 2)
     return np.arange(-m, m + 1)
 
 
 def shifted_ssim(a: np.ndarray, b: np.ndarray, shifts) -> np.ndarray:
-    """SSIM of ``np.roll(a, s, axis=1)`` with ``b`` for each shift ``s`` (exhaustive reference)."""
+    """SSIM of ``np.roll(a, s, axis=1)`` with ``b`` for each shift ``s`` (exhaustive reference).
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        Panoramas of the same shape, ``(H, W)`` grey or ``(H, W, C)`` RGB, grey levels 0-255.
+    shifts : int or array_like of int
+        Column shifts applied to ``a``.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(len(shifts),)`` float: :func:`ssim` for each shift.
+    """
     return np.array([ssim(np.roll(_gray(a), int(s), axis=1), b) for s in np.atleast_1d(shifts)])
 
 
 def best_shift(a: np.ndarray, b: np.ndarray, max_shift: int, refine: int = 3) -> tuple[int, float]:
     """The column shift ``s`` (``|s| <= max_shift``) for which ``np.roll(a, s, axis=1)`` best
     matches ``b``, and that SSIM: the ``refine`` shifts with the best row correlation
-    (:func:`column_shift_scores`) are scored by SSIM."""
+    (:func:`column_shift_scores`) are scored by SSIM.
+
+    Parameters
+    ----------
+    a, b : numpy.ndarray
+        Panoramas of the same shape, ``(H, W)`` grey or ``(H, W, C)`` RGB, grey levels 0-255.
+    max_shift : int
+        Largest shift searched, columns (clipped to ``W // 2``; one column is ``360 / W``
+        degrees).
+    refine : int, optional
+        Number of shifts scored by SSIM, default 3.
+
+    Returns
+    -------
+    shift : int
+        The best of the scored shifts, columns.
+    score : float
+        Its SSIM.
+
+    Raises
+    ------
+    ValueError
+        When the two images differ in shape.
+    """
     x = _gray(a)
     corr = column_shift_scores(x, b)
     shifts = signed_shifts(max_shift, x.shape[1])
@@ -144,6 +261,22 @@ class SSIMEncoder:
     when full. A query first shortlists the stored images whose grey thumbnails correlate best
     with it, then computes SSIM against those in channel-stacked batches (one blur of the cross
     products per batch of up to 128 images).
+
+    Parameters
+    ----------
+    threshold : float, optional
+        In [0, 1]: a query whose best SSIM is at least this is the stored observation; below
+        it, a new one (Table 6: 0.65, the default).
+    shortlist : int or None, optional
+        SSIM only this many stored images, the best by thumbnail correlation (default 24);
+        None compares with all of them.
+
+    Attributes
+    ----------
+    images : list of numpy.ndarray
+        The stored images in id order (copies of what was given, e.g. ``(H, W, 3)`` uint8 RGB).
+    last_scores : numpy.ndarray
+        ``(k,)`` SSIM of the latest :meth:`match` query against the ``k`` shortlisted ids.
     """
 
     def __init__(self, threshold: float = 0.65, shortlist: int | None = 24):
@@ -170,7 +303,24 @@ class SSIMEncoder:
             setattr(self, name, new)
 
     def add(self, image: np.ndarray) -> int:
-        """Store ``image`` as a new observation; returns its id."""
+        """Store ``image`` as a new observation.
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            ``(H, W)`` grey or ``(H, W, C)`` RGB image, grey levels 0-255; every stored image
+            has the same ``(H, W)``.
+
+        Returns
+        -------
+        int
+            Its observation id (the number of images stored before it).
+
+        Raises
+        ------
+        ValueError
+            When its size differs from the stored images'.
+        """
         x = _gray(image)
         if self.images and x.shape != self._x.shape[1:]:
             raise ValueError(f"image of shape {x.shape} does not match stored {self._x.shape[1:]}")
@@ -186,7 +336,25 @@ class SSIMEncoder:
         return k
 
     def scores(self, image: np.ndarray, ids: np.ndarray | None = None) -> np.ndarray:
-        """SSIM of ``image`` against the stored images ``ids`` (default: all)."""
+        """SSIM of ``image`` against the stored images ``ids`` (as :func:`ssim`, batched).
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            ``(H, W)`` grey or ``(H, W, C)`` RGB query, the stored images' size.
+        ids : array_like of int or None, optional
+            Stored ids to compare with; None (default) for all.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(len(ids),)`` float SSIM in the order of ``ids``; empty when nothing is stored.
+
+        Raises
+        ------
+        ValueError
+            When the query's size differs from the stored images'.
+        """
         n = len(self.images)
         if n == 0:
             return np.zeros(0)
@@ -215,7 +383,28 @@ class SSIMEncoder:
 
         Per stored image, the ``refine`` shifts with the best row correlation
         (:func:`column_shift_scores`) are scored by SSIM; a heading error of the panorama's
-        reference direction shows up as such a shift (one column = 360 / width degrees)."""
+        reference direction shows up as such a shift (one column = 360 / width degrees).
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            ``(H, W)`` grey or ``(H, W, C)`` RGB panorama, the stored images' size.
+        ids : int or array_like of int
+            Stored ids to compare with.
+        max_shift : int
+            Largest column shift searched.
+        refine : int, optional
+            Shifts scored by SSIM per stored image, default 3.
+
+        Returns
+        -------
+        id : int
+            The best-matching stored id; -1 when ``ids`` is empty (or no SSIM is positive).
+        shift : int
+            Column shift applied to ``image`` for that match.
+        ssim : float
+            That SSIM (0.0 with id -1).
+        """
         x = _gray(image)
         best = (-1, 0, 0.0)
         for k in np.atleast_1d(np.asarray(ids, dtype=int)):
@@ -225,7 +414,19 @@ class SSIMEncoder:
         return best
 
     def candidates(self, image: np.ndarray) -> np.ndarray:
-        """Stored ids worth an SSIM: all, or the ``shortlist`` best by thumbnail correlation."""
+        """Stored ids worth an SSIM: all, or the ``shortlist`` best by thumbnail correlation.
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            ``(H, W)`` grey or ``(H, W, C)`` RGB query.
+
+        Returns
+        -------
+        numpy.ndarray
+            Sorted int ids: every stored id when ``shortlist`` is None or not exceeded, else the
+            ``shortlist`` ids whose 8 x 32 grey thumbnails correlate best with the query's.
+        """
         n = len(self.images)
         if self.shortlist is None or n <= self.shortlist:
             return np.arange(n)
@@ -233,7 +434,22 @@ class SSIMEncoder:
         return np.sort(np.argpartition(-corr, self.shortlist)[: self.shortlist])
 
     def match(self, image: np.ndarray) -> tuple[int, float]:
-        """Best stored id and its score (-1, 0.0 when nothing is stored)."""
+        """Best stored id by SSIM among the :meth:`candidates`; stores nothing.
+
+        Sets :attr:`last_scores` to the SSIM of every candidate.
+
+        Parameters
+        ----------
+        image : numpy.ndarray
+            ``(H, W)`` grey or ``(H, W, C)`` RGB query.
+
+        Returns
+        -------
+        id : int
+            The best stored id; -1 when nothing is stored.
+        score : float
+            Its SSIM (0.0 when nothing is stored).
+        """
         ids = self.candidates(image)
         s = self.scores(image, ids)
         self.last_scores = s
