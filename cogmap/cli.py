@@ -1,5 +1,5 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap drone fly``, ``cogmap dvbf slam``, ``cogmap reproduce``.
+``cogmap drone fly``, ``cogmap dvbf slam|explore``, ``cogmap reproduce``.
 
 Every error ends the command with one line on stderr naming the problem and exit status 2
 (``--debug`` shows the traceback instead); ``cogmap --version`` prints the version.
@@ -70,6 +70,17 @@ def _dvbf(args) -> int:
                        pretrain_maze=pre)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, error.png, map.png)")
+    return 0
+
+
+def _dvbf_explore(args) -> int:
+    from .dvbf.run import explore_run
+
+    metrics = explore_run(args.maze, Path(args.out), steps=args.steps, seed=args.seed, complexity=args.complexity,
+                          corridor=args.corridor, methods=tuple(args.methods), progress=not args.quiet)
+    print(json.dumps({"ratio_at_end": metrics["ratio_at_budget"], "steps": metrics["steps"],
+                      "budget": metrics["budget"]}, indent=1))
+    print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, path.png, ratio.png)")
     return 0
 
 
@@ -148,6 +159,17 @@ def build_parser() -> argparse.ArgumentParser:
     ds.add_argument("--out", default="runs/dvbf-slam", help="run directory (default: runs/dvbf-slam)")
     ds.add_argument("--quiet", action="store_true")
     ds.set_defaults(func=_dvbf)
+    dx = vsub.add_parser("explore", help="exploration by mutual information against a random walk and frontiers")
+    dx.add_argument("--maze", type=int, default=1, help="maze seed, not 0 (default: 1)")
+    dx.add_argument("--complexity", default="simple", choices=("simple", "moderate", "complex"))
+    dx.add_argument("--corridor", default="small", choices=("small", "medium", "large"))
+    dx.add_argument("--steps", type=positive_int, default=None,
+                    help="steps per method (default: the Table II budget of the maze)")
+    dx.add_argument("--methods", nargs="+", default=["mi", "random", "frontier"], choices=("mi", "random", "frontier"))
+    dx.add_argument("--seed", type=int, default=0, help="start, noise and agent seed (default: 0)")
+    dx.add_argument("--out", default="runs/dvbf-explore", help="run directory (default: runs/dvbf-explore)")
+    dx.add_argument("--quiet", action="store_true")
+    dx.set_defaults(func=_dvbf_explore)
 
     from .study.runner import build_parser as study_arguments
 

@@ -13,6 +13,7 @@ and ``inference.elbo``.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -96,6 +97,48 @@ def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: i
     return params.emission, np.array(losses)
 
 
+@functools.lru_cache(maxsize=8)
+def _compiled(config: SLAMConfig, capacity: int):
+    """Optimizer, jitted ELBO step and jitted filter chunk of one configuration, shared by every
+    :class:`OnlineSLAM` with it, so a process compiles them once (compiling is most of a short run)."""
+    import equinox as eqx
+    import jax
+    import jax.numpy as jnp
+
+    from cogmap.genmodel.dvbf import log_likelihood, log_likelihood_marginal, transition_sample
+    from cogmap.inference.elbo import make_optimizer, make_train_step
+    from cogmap.inference.particle_filter import pf_step, weighted_moments
+
+    cfg = config.model
+    opt = make_optimizer(config.learning_rate)
+    train_step = make_train_step(cfg, opt, capacity)
+    sigma_t = jnp.asarray(cfg.sigma_t)
+
+    @eqx.filter_jit
+    def filter_chunk(key, state, us, xs, emission, q_map):
+        """``len(us)`` filter steps in one compiled scan; returns cached particles and moments."""
+
+        def lik(z, obs):
+            if config.marginal:
+                return log_likelihood_marginal(emission, q_map, z, obs, cfg, sigma=config.pf_sigma)
+            return log_likelihood(emission, q_map.mean, z, obs, cfg, sigma=config.pf_sigma)
+
+        def trans(k, z, ctrl):
+            return transition_sample(k, z, ctrl, sigma_t)
+
+        def body(s, inp):
+            k, u, x = inp
+            s, _ = pf_step(k, s, u, x, trans, lik)
+            idx = jax.random.choice(jax.random.fold_in(k, 7), s.particles.shape[0], (config.cache,),
+                                    p=jnp.exp(s.log_weights))
+            mean, std = weighted_moments(s)
+            return s, (s.particles[idx], mean, std)
+
+        return jax.lax.scan(body, state, (jax.random.split(key, us.shape[0]), us, xs))
+
+    return opt, train_step, filter_chunk
+
+
 class OnlineSLAM:
     """The online-SLAM loop as a stepper: :meth:`advance` filters new steps in chunks of
     ``train_every`` and trains the ELBO after each chunk. :func:`online_slam` runs it over a recorded
@@ -108,13 +151,11 @@ class OnlineSLAM:
     """
 
     def __init__(self, start, config: SLAMConfig, capacity: int, emission=None, first_scan=None):
-        import equinox as eqx
         import jax
         import jax.numpy as jnp
 
-        from cogmap.genmodel.dvbf import log_likelihood, log_likelihood_marginal, transition_sample
-        from cogmap.inference.elbo import init_opt_state, init_params, make_optimizer, make_train_step
-        from cogmap.inference.particle_filter import pf_init, pf_step, weighted_moments
+        from cogmap.inference.elbo import init_opt_state, init_params
+        from cogmap.inference.particle_filter import pf_init
 
         self.config = config
         cfg = config.model
@@ -125,34 +166,8 @@ class OnlineSLAM:
         if emission is not None:
             params = params._replace(emission=emission)
         self.params = params
-        self._opt = make_optimizer(config.learning_rate)
+        self._opt, self._train_step, self._filter_chunk = _compiled(config, self.capacity)
         self.opt_state = init_opt_state(self._opt, params)
-        self._train_step = make_train_step(cfg, self._opt, self.capacity)
-        sigma_t = jnp.asarray(cfg.sigma_t)
-
-        @eqx.filter_jit
-        def filter_chunk(key, state, us, xs, emission, q_map):
-            """``len(us)`` filter steps in one compiled scan; returns cached particles and moments."""
-
-            def lik(z, obs):
-                if config.marginal:
-                    return log_likelihood_marginal(emission, q_map, z, obs, cfg, sigma=config.pf_sigma)
-                return log_likelihood(emission, q_map.mean, z, obs, cfg, sigma=config.pf_sigma)
-
-            def trans(k, z, ctrl):
-                return transition_sample(k, z, ctrl, sigma_t)
-
-            def body(s, inp):
-                k, u, x = inp
-                s, _ = pf_step(k, s, u, x, trans, lik)
-                idx = jax.random.choice(jax.random.fold_in(k, 7), s.particles.shape[0], (config.cache,),
-                                        p=jnp.exp(s.log_weights))
-                mean, std = weighted_moments(s)
-                return s, (s.particles[idx], mean, std)
-
-            return jax.lax.scan(body, state, (jax.random.split(key, us.shape[0]), us, xs))
-
-        self._filter_chunk = filter_chunk
         particles = jnp.asarray(start, float) + jnp.asarray(config.init_std) * jax.random.normal(
             k_part, (config.n_particles, 3))
         self.state = pf_init(particles)
@@ -190,6 +205,11 @@ class OnlineSLAM:
             if len(self._pending_u) == self.config.train_every:
                 self._chunk()
         if flush and self._pending_u:
+            self._chunk()
+
+    def flush(self) -> None:
+        """Filter (and train after) the steps queued since the last full chunk."""
+        if self._pending_u:
             self._chunk()
 
     def _chunk(self) -> None:

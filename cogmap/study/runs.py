@@ -346,9 +346,15 @@ def run_drone(spec) -> dict:
     return run(spec)
 
 
+def run_dvbf_exploration(spec) -> dict:
+    from .dvbf_exploration import run_dvbf_exploration as run
+
+    return run(spec)
+
+
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
            "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
-           "drone": run_drone}
+           "drone": run_drone, "dvbf-exploration": run_dvbf_exploration}
 
 
 _DIGEST: str | None = None
