@@ -43,6 +43,9 @@ class ExploreConfig:
     :data:`STUDY_MI` for the ones the study uses); ``replan_every``: steps executed per plan (a
     multiple of ``train_every``); ``train_iters``/``train_every``: ELBO steps per filtered chunk;
     ``learn_map``: run the online SLAM for the baselines too (for their information gain);
+    ``penalty_from``: end points of the obstacle histogram from the scans ``"predicted"`` by the map mean
+    at the estimated poses (Algorithm 2, line 6) or from the ``"observed"`` scans at the estimated poses
+    (default: early in a run the learnt map predicts walls poorly and the agent ran into them);
     ``curve_every``: spacing of the recorded curves."""
 
     method: str = "mi"
@@ -51,6 +54,7 @@ class ExploreConfig:
     train_every: int = 10
     train_iters: int = 5
     learn_map: bool = False
+    penalty_from: str = "observed"
     max_turn: float = 0.35
     max_step: float = 0.01
     curve_every: int = 10
@@ -68,7 +72,7 @@ class ExploreConfig:
 
 
 #: planning settings of the study (much lighter than the paper's F = 40, L = 30, M = 40, K = 100)
-STUDY_MI = MIConfig(horizon=50, n_candidates=8, n_marginal=32, n_maps=8, n_per_map=16, opt_iters=100,
+STUDY_MI = MIConfig(horizon=50, n_candidates=6, n_marginal=24, n_maps=6, n_per_map=12, opt_iters=60,
                     obs_every=10, dim=4, pose_samples=2)
 
 
@@ -192,9 +196,12 @@ def _scan_predictor(model):
 class MIPlanner:
     """One planning call of the DVBF-LM agent on the current SLAM state (Algorithms 1-2)."""
 
-    def __init__(self, model, mi: MIConfig, extent: float, seed: int):
+    def __init__(self, model, mi: MIConfig, extent: float, seed: int, penalty_from: str = "predicted"):
         import jax
 
+        if penalty_from not in ("predicted", "observed"):
+            raise ValueError(f"MIPlanner: penalty_from must be 'predicted' or 'observed', got {penalty_from!r}")
+        self.penalty_from = penalty_from
         self.model, self.mi, self.extent = model, mi, extent
         self.side = max(2, int(np.ceil(extent / mi.hist_cell)))
         self.key = jax.random.PRNGKey(seed + 91)
@@ -216,7 +223,10 @@ class MIPlanner:
         idx = rng.integers(0, t + 1, self.n_hist)
         poses = slam.estimates[idx]
         q = slam.params.q_map
-        x_hat = np.asarray(self._predicted(slam.params.emission, q.mean, jnp.asarray(poses)))  # Algorithm 2, l. 6
+        if self.penalty_from == "predicted":  # Algorithm 2, l. 6: scans predicted by the map mean
+            x_hat = np.asarray(self._predicted(slam.params.emission, q.mean, jnp.asarray(poses)))
+        else:  # the scans the agent received there
+            x_hat = slam.scans[idx]
         ends = beam_endpoints(poses, x_hat, self.model.lidar_range)
         grid = obstacle_penalty_grid(ends, x_hat.size, self.extent, self.side)
         self.key, k_c, k_s = jax.random.split(self.key, 3)
@@ -303,7 +313,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         if cfg.method == "mi":
             mi = cfg.mi if cfg.mi.max_step == cfg.max_step and cfg.mi.max_turn == cfg.max_turn else \
                 dataclasses.replace(cfg.mi, max_step=cfg.max_step, max_turn=cfg.max_turn)
-            planner = MIPlanner(model, mi, maze.size, cfg.seed)
+            planner = MIPlanner(model, mi, maze.size, cfg.seed, cfg.penalty_from)
         policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
                   else Frontier(maze, cfg, cfg.seed, sim.lidar_range) if cfg.method == "frontier" else None)
         rng = np.random.default_rng([cfg.seed, 5])

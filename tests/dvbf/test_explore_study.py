@@ -68,7 +68,8 @@ def test_cli_parses_dvbf_explore():
 def test_study_plan_and_keys():
     plan = study_plan("dvbf-exploration", "reduced")
     assert plan["envs"] == ["simple-small", "moderate-small", "complex-small"]
-    assert plan["steps"] == {"simple-small": 1500, "moderate-small": 3000, "complex-small": 6000}  # Table II
+    assert plan["steps"] == {"simple-small": 200, "moderate-small": 200, "complex-small": 200}
+    assert study_plan("dvbf-exploration", "full")["steps"]["complex-large"] == 18000  # Table II
     assert len(plan["seeds"]) == 5
     specs = run_specs(plan)
     assert len({s["key"] for s in specs}) == len(specs) == 3 * 3 * 5
