@@ -198,6 +198,23 @@ def _optimise_impl(raw, z0, eps, grid, sig, extent, cfg):
     return r, before, _penalty_loss(r, z0, eps, grid, sig, extent, cfg)[1]
 
 
+def truncate_at_collision(controls, start, grid, extent: float, level: float = 0.5):
+    """Cut every candidate ``(F, T, 2)`` at its first predicted collision: from the first step whose mean
+    pose (rolled out from ``start (3,)``) reads an obstacle penalty above ``level``, the forward steps are
+    set to 0 (the agent stands and only turns). Returns the cut controls and the free steps ``(F,)``.
+
+    Our addition to the paper's procedure: a candidate that runs into a wall is then scored (and executed)
+    only up to the wall, so it gains no information from views it would never reach."""
+    u = np.array(controls, float)
+    paths = np.asarray(jax.vmap(lambda c: rollout(jnp.asarray(start, float), c))(jnp.asarray(u)))
+    pen = np.asarray(penalty_at(jnp.asarray(grid, float), jnp.asarray(paths[:, 1:, :2]), extent))
+    hit = pen > level
+    free = np.where(hit.any(1), hit.argmax(1), u.shape[1])
+    for f, n in enumerate(free):
+        u[f, n:, 1] = 0.0
+    return u, free
+
+
 # -- mutual information (Section VI-B) -----------------------------------------------------------
 
 def predictive_samples(key, q_map, emission, model: DVBFConfig, starts, controls, cfg: MIConfig):

@@ -217,6 +217,7 @@ class MIPlanner:
             candidate_controls,
             obstacle_penalty_grid,
             score_candidates,
+            truncate_at_collision,
         )
 
         t = slam.t
@@ -232,10 +233,11 @@ class MIPlanner:
         self.key, k_c, k_s = jax.random.split(self.key, 3)
         starts = slam.particles
         cand = candidate_controls(k_c, starts, grid, self.extent, self.mi, sigma_t=self.model.sigma_t)
-        scores = score_candidates(k_s, q, slam.params.emission, self.model, starts, cand.controls, self.mi)
+        controls, free = truncate_at_collision(cand.controls, slam.estimate, grid, self.extent)
+        scores = score_candidates(k_s, q, slam.params.emission, self.model, starts, controls, self.mi)
         best = int(np.argmax(scores))
-        return cand.controls[best], {"scores": scores, "best": best, "penalty": cand.penalty, "grid": grid,
-                                     "controls": cand.controls, "starts": np.asarray(starts)}
+        return controls[best], {"scores": scores, "best": best, "penalty": cand.penalty, "grid": grid,
+                                "controls": controls, "free_steps": free, "starts": np.asarray(starts)}
 
 
 def cache_dir():
@@ -328,9 +330,12 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
                 if not queue:
                     slam.flush()  # plan from the latest pose posterior
                     t0 = time.perf_counter()
-                    u_best, _ = planner.plan(slam, rng)
+                    u_best, info = planner.plan(slam, rng)
                     plan_seconds.append(time.perf_counter() - t0)
-                    queue = list(u_best[: cfg.replan_every])
+                    # execute up to the predicted collision, rounded up to whole filter chunks (standing after it)
+                    free = int(info["free_steps"][info["best"]])
+                    n = min(cfg.replan_every, cfg.train_every * max(1, -(-free // cfg.train_every)))
+                    queue = list(u_best[:n])
                 u = queue.pop(0)
             else:
                 u = policy.act(pose, scan, bool(blocked))

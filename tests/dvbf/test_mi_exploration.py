@@ -17,6 +17,7 @@ from cogmap.planning.mi_exploration import (
     rollout,
     score_candidates,
     squash_controls,
+    truncate_at_collision,
 )
 
 
@@ -94,3 +95,17 @@ def test_projected_mi_of_a_known_gaussian_channel():
     assert projected_mutual_information(marg, cond, dim=3) == pytest.approx(1.5 * np.log(5), abs=0.2)
     with pytest.raises(ValueError, match="conditionals"):
         projected_mutual_information(marg, cond[0], dim=3)
+
+
+def test_candidates_are_cut_at_their_first_predicted_collision():
+    wall = np.stack([np.full(200, 0.5), np.linspace(0, 1, 200)], 1)
+    grid = obstacle_penalty_grid(wall, 200, 1.0, 50)
+    east = np.tile([[0.0, 0.01]], (40, 1))
+    north = east.copy()
+    north[0, 0] = np.pi / 2
+    cut, free = truncate_at_collision(np.stack([east, north]), np.array([0.3, 0.5, 0.0]), grid, 1.0)
+    # heading east: 19 steps reach x = 0.49, the last pose before the wall's cell (bins of 0.02, read
+    # bilinearly between cell centres); the 20th would stand on the wall
+    assert free[0] == 19 and free[1] == 40
+    assert np.all(cut[0, free[0]:, 1] == 0) and np.all(cut[0, :free[0], 1] == 0.01)
+    assert np.array_equal(cut[1], north) and np.array_equal(cut[:, :, 0], np.stack([east, north])[:, :, 0])
