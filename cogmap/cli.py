@@ -1,5 +1,5 @@
 """Command line: ``cogmap explore``, ``cogmap goal``, ``cogmap compare-inference``,
-``cogmap drone fly``, ``cogmap dvbf slam``, ``cogmap dvbf navigate``, ``cogmap reproduce``.
+``cogmap drone fly``, ``cogmap dvbf slam|navigate|explore``, ``cogmap reproduce``.
 
 Every error ends the command with one line on stderr naming the problem and exit status 2
 (``--debug`` shows the traceback instead); ``cogmap --version`` prints the version.
@@ -95,6 +95,17 @@ def _dvbf_navigate(args) -> int:
     shown = ("maze_seed", "pairs", "learned", "learned_mean", "true", "length_ratio", "length_ratio_learned_mean")
     print(json.dumps({k: v for k, v in metrics.items() if k in shown}, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, pairs.csv, poses.csv, metrics.json, paths.png)")
+    return 0
+
+
+def _dvbf_explore(args) -> int:
+    from .dvbf.run import explore_run
+
+    metrics = explore_run(args.maze, Path(args.out), steps=args.steps, seed=args.seed, complexity=args.complexity,
+                          corridor=args.corridor, methods=tuple(args.methods), progress=not args.quiet)
+    print(json.dumps({"ratio_at_end": metrics["ratio_at_budget"], "steps": metrics["steps"],
+                      "budget": metrics["budget"]}, indent=1))
+    print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, path.png, ratio.png)")
     return 0
 
 
@@ -201,6 +212,18 @@ def build_parser() -> argparse.ArgumentParser:
     dn.add_argument("--quiet", action="store_true")
     add_run_options(dn)
     dn.set_defaults(func=_dvbf_navigate, out_dir=lambda a: Path(a.out))
+    dx = vsub.add_parser("explore", help="exploration by mutual information against a random walk and frontiers")
+    dx.add_argument("--maze", type=int, default=1, help="maze seed, not 0 (default: 1)")
+    dx.add_argument("--complexity", default="simple", choices=("simple", "moderate", "complex"))
+    dx.add_argument("--corridor", default="small", choices=("small", "medium", "large"))
+    dx.add_argument("--steps", type=positive_int, default=None,
+                    help="steps per method (default: the Table II budget of the maze)")
+    dx.add_argument("--methods", nargs="+", default=["mi", "random", "frontier"], choices=("mi", "random", "frontier"))
+    dx.add_argument("--seed", type=int, default=0, help="start, noise and agent seed (default: 0)")
+    dx.add_argument("--out", default="runs/dvbf-explore", help="run directory (default: runs/dvbf-explore)")
+    dx.add_argument("--quiet", action="store_true")
+    add_run_options(dx)
+    dx.set_defaults(func=_dvbf_explore, out_dir=lambda a: Path(a.out))
 
     from .study.runner import build_parser as study_arguments
 

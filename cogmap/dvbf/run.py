@@ -146,3 +146,115 @@ def _error_png(err, err_pi, filename) -> None:
         fig.savefig(filename, dpi=110)
     finally:
         plt.close(fig)
+
+
+def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int = 0, complexity: str = "simple",
+                corridor: str = "small", methods=("mi", "random", "frontier"), cache_dir=None,
+                progress: bool = True, **overrides) -> dict:
+    """``cogmap dvbf explore``: explore maze ``maze_seed`` with the DVBF-LM agent and the baselines from the same
+    start for ``steps`` steps (default: the Table II budget) and write the run directory ``out``.
+
+    The directory holds ``run.json``, ``model.npz`` + ``model.json`` (the MI agent's final q(M) and emission),
+    ``trajectory.csv`` (per method and step: true pose, the agent's estimate, control), ``metrics.json``
+    (exploration ratio at the budget, its curve, information gain, planning time), ``path.png`` (the paths on
+    the maze) and ``ratio.png`` (exploration ratio and information gain against the steps).
+    ``overrides`` replace :class:`~cogmap.dvbf.explore.ExploreConfig` fields.
+    """
+    from cogmap.envs.maze_render import save_maze_png
+    from cogmap.runs import write_manifest
+
+    from .explore import STUDY_MI, ExploreConfig, explore, pretrained_emission, ratio_at
+    from .explore import cache_dir as cache_dir_default
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    maze = make_maze(maze_seed, complexity, corridor)
+    steps = maze.step_budget if steps is None else int(steps)
+    if maze_seed == 0:
+        raise ValueError("explore_run: the emission is pretrained on maze 0; explore another maze")
+    overrides = {"mi": STUDY_MI, **overrides}
+    cfgs = {m: ExploreConfig(method=m, seed=seed, **overrides) for m in methods}
+    write_manifest(out, command="dvbf explore", maze_seed=maze_seed, complexity=complexity, corridor=corridor,
+                   steps=steps, seed=seed, noise=asdict(NOISE), configs={m: c.to_json() for m, c in cfgs.items()})
+    needs_model = any(m == "mi" or c.learn_map for m, c in cfgs.items())
+    emission = pretrained_emission(cache_dir or cache_dir_default()) if needs_model else None
+    results, metrics = {}, {"maze_seed": maze_seed, "complexity": complexity, "corridor": corridor, "steps": steps,
+                            "budget": maze.step_budget, "tiles": maze.tiles, "seed": seed, "methods": {}}
+    for m, c in cfgs.items():
+        bar = None
+        if progress:
+            from tqdm import tqdm
+
+            bar = tqdm(total=steps - 1, desc=m, unit="step")
+        res = explore(maze, steps, c, emission=emission, progress=(lambda _t, b=bar: b.update(1)) if bar else None)
+        if bar is not None:
+            bar.close()
+        results[m] = res
+        metrics["methods"][m] = summarise(res, maze, steps)
+    if "mi" in results and results["mi"].params is not None:
+        save_params(results["mi"].params, results["mi"].model, out)
+    with open(out / "trajectory.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["method", "step", "true_x", "true_y", "true_heading", "est_x", "est_y", "est_heading",
+                    "turn", "forward"])
+        for m, r in results.items():
+            for t in range(len(r.poses)):
+                est = r.estimates[t] if r.estimates is not None else (np.nan,) * 3
+                u = r.controls[t] if t < len(r.controls) else (np.nan, np.nan)
+                w.writerow([m, t, *np.round(r.poses[t], 6), *np.round(est, 6), *np.round(u, 6)])
+    metrics["ratio_at_budget"] = {m: ratio_at(r.ratio_curve, steps - 1) for m, r in results.items()}
+    (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
+    colours = {"mi": "tab:blue", "random": "tab:red", "frontier": "tab:green"}
+    save_maze_png(maze, out / "path.png", paths=[(f"{m} ({metrics['ratio_at_budget'][m]:.2f})", r.poses,
+                                                  colours.get(m, "k")) for m, r in results.items()],
+                  title=f"maze {maze_seed} ({complexity}, {corridor}): {steps} steps")
+    _ratio_png(results, maze, out / "ratio.png")
+    return metrics
+
+
+def summarise(res, maze, steps: int) -> dict:
+    """Metrics of one :class:`~cogmap.dvbf.explore.ExploreResult`."""
+    from .explore import ratio_at
+
+    plan = np.array(res.plan_seconds) if res.plan_seconds else None
+    out = {"ratio_final": ratio_at(res.ratio_curve, steps - 1), "ratio_curve": res.ratio_curve,
+           "info_gain_curve": res.info_curve, "info_gain_final": res.info_curve[-1][1] if res.info_curve else None,
+           "blocked_steps": res.blocked, "path_length": float(np.sum(np.hypot(*np.diff(res.poses[:, :2], axis=0).T))),
+           "run_s": res.seconds, "plan_calls": len(res.plan_seconds),
+           "plan_call_median_s": float(np.median(plan)) if plan is not None else None,
+           "plan_call_first_s": float(plan[0]) if plan is not None else None}
+    if res.estimates is not None:
+        err = np.hypot(*(res.estimates[:, :2] - res.poses[:, :2]).T)
+        out["localisation_error_final"] = float(err[-1])
+        out["localisation_error_mean"] = float(err.mean())
+    return out
+
+
+def _ratio_png(results, maze, filename) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    has_info = any(r.info_curve for r in results.values())
+    fig, axes = plt.subplots(1, 2 if has_info else 1, figsize=(10 if has_info else 5.5, 3.6), squeeze=False)
+    colours = {"mi": "tab:blue", "random": "tab:red", "frontier": "tab:green"}
+    try:
+        for m, r in results.items():
+            c = np.array(r.ratio_curve)
+            axes[0, 0].plot(c[:, 0], c[:, 1], c=colours.get(m, "k"), label=m)
+            if has_info and r.info_curve:
+                i = np.array(r.info_curve)
+                axes[0, 1].plot(i[:, 0], i[:, 1], c=colours.get(m, "k"), label=m)
+        axes[0, 0].set_xlabel("step")
+        axes[0, 0].set_ylabel(f"exploration ratio ({maze.tiles} x {maze.tiles} tiles)")
+        axes[0, 0].set_ylim(0, 1.02)
+        axes[0, 0].legend()
+        if has_info:
+            axes[0, 1].set_xlabel("step")
+            axes[0, 1].set_ylabel("information gain KL(q(M) || p(M)) (nats)")
+            axes[0, 1].legend()
+        fig.tight_layout()
+        fig.savefig(filename, dpi=110)
+    finally:
+        plt.close(fig)

@@ -13,6 +13,7 @@ and ``inference.elbo``.
 
 from __future__ import annotations
 
+import functools
 import time
 from dataclasses import asdict, dataclass, field
 
@@ -108,35 +109,21 @@ def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: i
     return params.emission, losses
 
 
-def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emission=None) -> SLAMResult:
-    """Run online SLAM on ``scans (T, n_beams)`` and ``controls (T - 1, 2)`` from the known ``start``.
-
-    ``emission``: an emission network to start from (for example one trained on a first maze, as
-    the paper pretrains its transition); by default a freshly initialised one. The map always starts
-    at the prior.
-    """
+@functools.lru_cache(maxsize=8)
+def _compiled(config: SLAMConfig, capacity: int):
+    """Optimizer, jitted ELBO step and jitted filter chunk of one configuration, shared by every
+    :class:`OnlineSLAM` with it, so a process compiles them once (compiling is most of a short run)."""
     import equinox as eqx
     import jax
     import jax.numpy as jnp
 
     from cogmap.genmodel.dvbf import log_likelihood, log_likelihood_marginal, transition_sample
-    from cogmap.inference.elbo import Batch, init_opt_state, init_params, make_optimizer, make_train_step
-    from cogmap.inference.particle_filter import pf_init, pf_step, weighted_moments
+    from cogmap.inference.elbo import make_optimizer, make_train_step
+    from cogmap.inference.particle_filter import pf_step, weighted_moments
 
     cfg = config.model
-    scans = jnp.asarray(np.asarray(scans, float))
-    controls = jnp.asarray(np.asarray(controls, float))
-    T = scans.shape[0]
-    if controls.shape[0] != T - 1:
-        raise ValueError(f"online_slam: {controls.shape[0]} controls for {T} scans (need T - 1)")
-    key = jax.random.PRNGKey(config.seed)
-    key, k_init, k_part = jax.random.split(key, 3)
-    params = init_params(cfg, k_init)
-    if emission is not None:
-        params = params._replace(emission=emission)
     opt = make_optimizer(config.learning_rate)
-    opt_state = init_opt_state(opt, params)
-    train_step = make_train_step(cfg, opt, T)
+    train_step = make_train_step(cfg, opt, capacity)
     sigma_t = jnp.asarray(cfg.sigma_t)
 
     @eqx.filter_jit
@@ -161,35 +148,135 @@ def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emiss
 
         return jax.lax.scan(body, state, (jax.random.split(key, us.shape[0]), us, xs))
 
-    particles = jnp.asarray(start, float) + jnp.asarray(config.init_std) * jax.random.normal(
-        k_part, (config.n_particles, 3))
-    state = pf_init(particles)
-    cache = np.zeros((T, config.cache, 3), np.float32)
-    cache[0] = np.asarray(particles[: config.cache])
-    estimates, spreads = np.zeros((T, 3)), np.zeros((T, 3))
-    estimates[0] = np.asarray(start, float)
-    spreads[0] = np.asarray(config.init_std)
-    losses = []
-    rng = np.random.default_rng(config.seed)
+    return opt, train_step, filter_chunk
+
+
+class OnlineSLAM:
+    """The online-SLAM loop as a stepper: :meth:`advance` filters new steps in chunks of
+    ``train_every`` and trains the ELBO after each chunk. :func:`online_slam` runs it over a recorded
+    traversal; the exploration agent (:mod:`cogmap.dvbf.explore`) feeds it step by step.
+
+    ``capacity``: the most steps that will be seen (scales the ELBO's reconstruction term, Eq. 3, and
+    sizes the buffers). ``emission``: an emission network to start from (for example one trained on a
+    first maze, as the paper pretrains its transition); by default a freshly initialised one. The map
+    always starts at the prior; the initial pose ``start`` is known.
+    """
+
+    def __init__(self, start, config: SLAMConfig, capacity: int, emission=None, first_scan=None):
+        import jax
+        import jax.numpy as jnp
+
+        from cogmap.inference.elbo import init_opt_state, init_params
+        from cogmap.inference.particle_filter import pf_init
+
+        self.config = config
+        cfg = config.model
+        self.capacity = int(capacity)
+        key = jax.random.PRNGKey(config.seed)
+        self.key, k_init, k_part = jax.random.split(key, 3)
+        params = init_params(cfg, k_init)
+        if emission is not None:
+            params = params._replace(emission=emission)
+        self.params = params
+        self._opt, self._train_step, self._filter_chunk = _compiled(config, self.capacity)
+        self.opt_state = init_opt_state(self._opt, params)
+        particles = jnp.asarray(start, float) + jnp.asarray(config.init_std) * jax.random.normal(
+            k_part, (config.n_particles, 3))
+        self.state = pf_init(particles)
+        T = self.capacity
+        self.cache = np.zeros((T, config.cache, 3), np.float32)
+        self.cache[0] = np.asarray(particles[: config.cache])
+        self.scans = np.zeros((T, cfg.n_beams), np.float32)
+        if first_scan is not None:
+            self.scans[0] = np.asarray(first_scan, float)
+        self.estimates, self.spreads = np.zeros((T, 3)), np.zeros((T, 3))
+        self.estimates[0] = np.asarray(start, float)
+        self.spreads[0] = np.asarray(config.init_std)
+        self.losses: list[float] = []
+        self.t = 0  # index of the last step filtered
+        self._rng = np.random.default_rng(config.seed)
+        self._pending_u: list[np.ndarray] = []
+        self._pending_x: list[np.ndarray] = []
+
+    @property
+    def particles(self) -> np.ndarray:
+        return np.asarray(self.state.particles)
+
+    @property
+    def estimate(self) -> np.ndarray:
+        """Weighted particle mean at the last filtered step (pending steps not yet included)."""
+        return self.estimates[self.t]
+
+    def advance(self, controls, scans, flush: bool = False) -> None:
+        """Queue steps (``controls (n, 2)`` leading to ``scans (n, n_beams)``); every full chunk of
+        ``train_every`` steps is filtered and followed by ``train_iters`` ELBO steps. ``flush`` also
+        processes a last, shorter chunk."""
+        for u, x in zip(np.atleast_2d(controls), np.atleast_2d(scans), strict=True):
+            self._pending_u.append(np.asarray(u, float))
+            self._pending_x.append(np.asarray(x, float))
+            if len(self._pending_u) == self.config.train_every:
+                self._chunk()
+        if flush and self._pending_u:
+            self._chunk()
+
+    def flush(self) -> None:
+        """Filter (and train after) the steps queued since the last full chunk."""
+        if self._pending_u:
+            self._chunk()
+
+    def _chunk(self) -> None:
+        import jax
+        import jax.numpy as jnp
+
+        from cogmap.inference.elbo import Batch
+
+        config, t = self.config, self.t
+        n = len(self._pending_u)
+        if t + n >= self.capacity:
+            raise ValueError(f"OnlineSLAM: more than capacity = {self.capacity} steps")
+        us, xs = np.array(self._pending_u), np.array(self._pending_x)
+        self._pending_u, self._pending_x = [], []
+        self.key, k = jax.random.split(self.key)
+        self.state, (cached, mean, std) = self._filter_chunk(k, self.state, jnp.asarray(us), jnp.asarray(xs),
+                                                             self.params.emission, self.params.q_map)
+        self.scans[t + 1:t + 1 + n] = xs
+        self.cache[t + 1:t + 1 + n] = np.asarray(cached)
+        self.estimates[t + 1:t + 1 + n], self.spreads[t + 1:t + 1 + n] = np.asarray(mean), np.asarray(std)
+        t = self.t = t + n
+        scans = self.scans
+        for _ in range(config.train_iters):
+            n_recent = int(round(config.recent * config.batch))
+            idx = np.concatenate([self._rng.integers(max(0, t + 1 - config.recent_window), t + 1, n_recent),
+                                  self._rng.integers(0, t + 1, config.batch - n_recent)])
+            self.key, k = jax.random.split(self.key)
+            new, self.opt_state, terms = self._train_step(self.params, self.opt_state, k,
+                                                          Batch(jnp.asarray(self.cache[idx]),
+                                                                jnp.asarray(scans[idx])))
+            self.params = new._replace(emission=self.params.emission) if config.freeze_emission else new
+            self.losses.append(float(terms.loss))
+
+
+def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emission=None) -> SLAMResult:
+    """Run online SLAM on ``scans (T, n_beams)`` and ``controls (T - 1, 2)`` from the known ``start``
+    (:class:`OnlineSLAM` over a recorded traversal).
+
+    ``emission``: an emission network to start from (for example one trained on a first maze, as
+    the paper pretrains its transition); by default a freshly initialised one. The map always starts
+    at the prior.
+    """
+    scans = np.asarray(scans, float)
+    controls = np.asarray(controls, float)
+    T = scans.shape[0]
+    if controls.shape[0] != T - 1:
+        raise ValueError(f"online_slam: {controls.shape[0]} controls for {T} scans (need T - 1)")
+    slam = OnlineSLAM(start, config, T, emission=emission, first_scan=scans[0])
     tic = time.perf_counter()
     t = 0
     while t < T - 1:
         n = min(config.train_every, T - 1 - t)
-        key, k = jax.random.split(key)
-        state, (cached, mean, std) = filter_chunk(k, state, controls[t:t + n], scans[t + 1:t + 1 + n],
-                                                  params.emission, params.q_map)
-        cache[t + 1:t + 1 + n] = np.asarray(cached)
-        estimates[t + 1:t + 1 + n], spreads[t + 1:t + 1 + n] = np.asarray(mean), np.asarray(std)
+        slam.advance(controls[t:t + n], scans[t + 1:t + 1 + n], flush=True)
         t += n
-        for _ in range(config.train_iters):
-            n_recent = int(round(config.recent * config.batch))
-            idx = np.concatenate([rng.integers(max(0, t + 1 - config.recent_window), t + 1, n_recent),
-                                  rng.integers(0, t + 1, config.batch - n_recent)])
-            key, k = jax.random.split(key)
-            new, opt_state, terms = train_step(params, opt_state, k, Batch(jnp.asarray(cache[idx]), scans[idx]))
-            params = new._replace(emission=params.emission) if config.freeze_emission else new
-            losses.append(float(terms.loss))
         if progress is not None:
             progress(t)
-    return SLAMResult(estimates, spreads, np.asarray(state.particles), params, np.array(losses),
+    return SLAMResult(slam.estimates, slam.spreads, slam.particles, slam.params, np.array(slam.losses),
                       time.perf_counter() - tic)

@@ -9,7 +9,7 @@ import json
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
 STUDIES = ("exploration", "success", "goals", "drift", "slip", "dropout", "obstacle", "scaling", "drone",
-           "dvbf-navigation")
+           "dvbf-navigation", "dvbf-exploration")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -98,6 +98,11 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         from .dvbf_navigation import nav_plan
 
         return nav_plan(scale, seeds=seeds, methods=methods, envs=envs)
+
+    if study == "dvbf-exploration":  # LiDAR mazes (cogmap.study.dvbf_exploration)
+        from .dvbf_exploration import dvbf_exploration_plan
+
+        return dvbf_exploration_plan(scale, seeds=seeds, methods=methods, envs=envs)
     full = scale == "full"
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
@@ -189,6 +194,11 @@ def run_specs(plan: dict) -> list[dict]:
         from .dvbf_navigation import nav_specs
 
         return nav_specs(plan)
+
+    if plan["study"] == "dvbf-exploration":
+        from .dvbf_exploration import dvbf_exploration_specs
+
+        return dvbf_exploration_specs(plan)
     unknown = [m for m in plan["methods"] if m not in METHOD_OPTIONS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; choose from {list(METHOD_OPTIONS)}")

@@ -511,6 +511,15 @@ def _dvbf_navigation_report(study_dir: Path, plan, results) -> str:
 REPORTS["dvbf-navigation"] = _dvbf_navigation_report
 
 
+def _dvbf_exploration_report(study_dir: Path, plan, results) -> str:
+    from .dvbf_exploration import dvbf_exploration_report
+
+    return dvbf_exploration_report(study_dir, plan, results)
+
+
+REPORTS["dvbf-exploration"] = _dvbf_exploration_report
+
+
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
     study_dir = Path(study_dir)
     body = REPORTS[name](study_dir, plan, results)

@@ -352,9 +352,16 @@ def run_dvbf_navigation(spec) -> dict:
     return run_navigation(spec)
 
 
+def run_dvbf_exploration(spec) -> dict:
+    from .dvbf_exploration import run_dvbf_exploration as run
+
+    return run(spec)
+
+
 RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
            "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
-           "drone": run_drone, "dvbf-navigation": run_dvbf_navigation}
+           "drone": run_drone, "dvbf-navigation": run_dvbf_navigation,
+           "dvbf-exploration": run_dvbf_exploration}
 
 
 _DIGEST: str | None = None

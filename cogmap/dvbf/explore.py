@@ -1,0 +1,381 @@
+"""Exploration of a LiDAR maze with DVBF-LM (paper Section VI, Algorithm 1) and two baselines.
+
+* ``mi``: the DVBF-LM agent. It learns the map online while it moves (:class:`~cogmap.dvbf.slam.OnlineSLAM`,
+  20 particles, ELBO steps after every ``train_every`` steps; emission pretrained on a first maze and
+  frozen, as in ``cogmap dvbf slam``). Every ``replan_every`` steps it builds the obstacle penalty from
+  its own map, generates candidate control sequences, scores them by ``I(x_1:T; M)``
+  (:mod:`cogmap.planning.mi_exploration`) and executes the first ``replan_every`` controls of the best.
+* ``random``: a random walk: each step a uniform turn in ``[-max_turn, max_turn]`` and a full step;
+  after a wall stopped it, a uniform turn in ``[-pi, pi]``.
+* ``frontier``: a frontier explorer on an occupancy grid built from the **true** LiDAR returns at the
+  **true** poses (a privileged baseline: no localisation error), cells of a quarter corridor width;
+  it walks the shortest 4-connected path through known-free cells to the nearest frontier cell
+  (known free, next to unknown) and re-plans when it arrives, every ``replan_every`` steps or when a
+  wall stops it; with no frontier left it walks randomly.
+
+All three move with the same control bounds (turn at most 0.35 rad, step at most 0.01 per time step,
+actuation noise of ``cogmap dvbf slam``) from the same seeded start. The exploration ratio is measured
+on the true positions over the Table II tiles (:func:`cogmap.envs.maze.exploration_ratio`); the
+information gain is ``KL(q(M) || p(M))`` of the agent's map (Appendix D), for the baselines when
+``learn_map`` is on (the same online SLAM fed with their data).
+"""
+
+from __future__ import annotations
+
+import functools
+import time
+from collections import deque
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from cogmap.envs.maze import Maze, exploration_ratio
+from cogmap.envs.maze_sim import ActuationNoise, MazeSim, wrap_angle
+from cogmap.planning.mi_exploration import MIConfig
+
+METHODS = ("mi", "random", "frontier")
+NOISE = ActuationNoise(rot_std=0.005, trans_frac=0.05)
+
+
+@dataclass(frozen=True)
+class ExploreConfig:
+    """One exploration run. ``mi``: planning settings (the paper's defaults are heavy: see
+    :data:`STUDY_MI` for the ones the study uses); ``replan_every``: steps executed per plan (a
+    multiple of ``train_every``); ``train_iters``/``train_every``: ELBO steps per filtered chunk;
+    ``learn_map``: run the online SLAM for the baselines too (for their information gain);
+    ``penalty_from``: end points of the obstacle histogram from the scans ``"predicted"`` by the map mean
+    at the estimated poses (Algorithm 2, line 6) or from the ``"observed"`` scans at the estimated poses
+    (default: early in a run the learnt map predicts walls poorly and the agent ran into them);
+    ``curve_every``: spacing of the recorded curves."""
+
+    method: str = "mi"
+    mi: MIConfig = field(default_factory=MIConfig)
+    replan_every: int = 50
+    train_every: int = 10
+    train_iters: int = 5
+    learn_map: bool = False
+    penalty_from: str = "observed"
+    max_turn: float = 0.35
+    max_step: float = 0.01
+    curve_every: int = 10
+    seed: int = 0
+
+    def __post_init__(self):
+        if self.method not in METHODS:
+            raise ValueError(f"ExploreConfig: method must be one of {METHODS}, got {self.method!r}")
+        if self.replan_every < 1 or self.replan_every % self.train_every:
+            raise ValueError(f"ExploreConfig: replan_every ({self.replan_every}) must be a positive multiple of "
+                             f"train_every ({self.train_every})")
+
+    def to_json(self) -> dict:
+        return asdict(self)
+
+
+#: planning settings of the study (much lighter than the paper's F = 40, L = 30, M = 40, K = 100)
+STUDY_MI = MIConfig(horizon=50, n_candidates=6, n_marginal=24, n_maps=6, n_per_map=12, opt_iters=60,
+                    obs_every=10, dim=4, pose_samples=2)
+
+
+@dataclass
+class ExploreResult:
+    poses: np.ndarray  # (T, 3) true poses
+    controls: np.ndarray  # (T - 1, 2) commanded
+    scans: np.ndarray  # (T, n_beams)
+    estimates: np.ndarray | None  # (T, 3) the agent's pose estimates (mi / learn_map)
+    ratio_curve: list  # [(step, exploration ratio)]
+    info_curve: list  # [(step, KL(q(M) || p(M)))]
+    plan_seconds: list  # wall clock of each planning call
+    blocked: int
+    params: object = None  # DVBF params at the end (mi / learn_map)
+    model: object = None  # DVBFConfig
+    seconds: float = 0.0
+
+
+def start_pose(maze: Maze, seed: int) -> np.ndarray:
+    """A seeded start: the centre of a random cell, a random heading (the same for every method)."""
+    rng = np.random.default_rng([seed, 17])
+    c = (int(rng.integers(maze.n)), int(rng.integers(maze.n)))
+    return np.array([*maze.cell_centre(*c), float(rng.uniform(-np.pi, np.pi))])
+
+
+# -- baselines -----------------------------------------------------------------------------------
+
+class RandomWalk:
+    def __init__(self, cfg: ExploreConfig, seed: int):
+        self.cfg, self.rng, self.bounce = cfg, np.random.default_rng([seed, 1]), False
+
+    def act(self, pose, scan, blocked: bool) -> np.ndarray:
+        if blocked:
+            return np.array([self.rng.uniform(-np.pi, np.pi), self.cfg.max_step])
+        return np.array([self.rng.uniform(-self.cfg.max_turn, self.cfg.max_turn), self.cfg.max_step])
+
+
+class Frontier:
+    """Nearest-frontier exploration on an occupancy grid from the true LiDAR returns at the true poses."""
+
+    def __init__(self, maze: Maze, cfg: ExploreConfig, seed: int, lidar_range: float):
+        self.cfg, self.maze = cfg, maze
+        self.res = maze.cell / 4
+        self.side = int(round(maze.size / self.res))
+        self.grid = np.zeros((self.side, self.side), np.int8)  # 0 unknown, 1 free, 2 occupied
+        self.range = lidar_range
+        self.walk = RandomWalk(cfg, seed)
+        self.path: list[np.ndarray] = []
+        self.since = 0
+
+    def _cell(self, xy):
+        return np.clip(np.floor(np.asarray(xy) / self.res).astype(int), 0, self.side - 1)
+
+    def update(self, pose, scan) -> None:
+        n = len(scan)
+        ang = pose[2] + 2 * np.pi * np.arange(n) / n
+        d = np.stack([np.cos(ang), np.sin(ang)], 1)
+        for r, v in zip(scan, d, strict=True):
+            s = np.arange(0.0, max(r - self.res, 0.0), self.res / 2)
+            ij = self._cell(pose[:2] + s[:, None] * v)
+            free = self.grid[ij[:, 0], ij[:, 1]] != 2
+            self.grid[ij[free, 0], ij[free, 1]] = 1
+            if r < 0.999 * self.range:
+                i, j = self._cell(pose[:2] + r * v)
+                self.grid[i, j] = 2
+
+    def _plan(self, pose) -> list[np.ndarray]:
+        start = tuple(self._cell(pose[:2]))
+        prev = {start: None}
+        q = deque([start])
+        g = self.grid
+        while q:
+            c = q.popleft()
+            i, j = c
+            if c != start and any(0 <= a < self.side and 0 <= b < self.side and g[a, b] == 0
+                                  for a, b in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1))):
+                path = [c]
+                while prev[path[-1]] is not None:
+                    path.append(prev[path[-1]])
+                return [(np.array(p, float) + 0.5) * self.res for p in path[::-1][1:]]
+            for nb in ((i + 1, j), (i - 1, j), (i, j + 1), (i, j - 1)):
+                if 0 <= nb[0] < self.side and 0 <= nb[1] < self.side and nb not in prev and g[nb] == 1:
+                    prev[nb] = c
+                    q.append(nb)
+        return []
+
+    def act(self, pose, scan, blocked: bool) -> np.ndarray:
+        self.update(pose, scan)
+        self.since += 1
+        if blocked or not self.path or self.since >= self.cfg.replan_every:
+            self.path = self._plan(pose)
+            self.since = 0
+        while self.path and np.hypot(*(self.path[0] - pose[:2])) < 0.6 * self.cfg.max_step:
+            self.path.pop(0)
+        if not self.path:
+            return self.walk.act(pose, scan, blocked)
+        d = self.path[0] - pose[:2]
+        err = float(wrap_angle(np.arctan2(d[1], d[0]) - pose[2]))
+        turn = float(np.clip(err, -self.cfg.max_turn, self.cfg.max_turn))
+        fwd = min(self.cfg.max_step, float(np.hypot(*d))) if abs(err - turn) < 0.5 else 0.0
+        return np.array([turn, fwd])
+
+
+# -- the DVBF-LM agent ---------------------------------------------------------------------------
+
+@functools.lru_cache(maxsize=8)
+def _scan_predictor(model):
+    """Jitted mean scans ``(N, n_beams)`` at poses ``(N, 3)`` for one map grid (one per model and process)."""
+    import equinox as eqx
+    import jax
+
+    from cogmap.genmodel.dvbf import predict_scan
+
+    @eqx.filter_jit
+    def predicted(emission, grid, poses):
+        return jax.vmap(lambda z: predict_scan(emission, grid, z, model))(poses)
+
+    return predicted
+
+
+class MIPlanner:
+    """One planning call of the DVBF-LM agent on the current SLAM state (Algorithms 1-2)."""
+
+    def __init__(self, model, mi: MIConfig, extent: float, seed: int, penalty_from: str = "predicted"):
+        import jax
+
+        if penalty_from not in ("predicted", "observed"):
+            raise ValueError(f"MIPlanner: penalty_from must be 'predicted' or 'observed', got {penalty_from!r}")
+        self.penalty_from = penalty_from
+        self.model, self.mi, self.extent = model, mi, extent
+        self.side = max(2, int(np.ceil(extent / mi.hist_cell)))
+        self.key = jax.random.PRNGKey(seed + 91)
+        self.n_hist = 400  # visited poses used for the obstacle histogram (fixed: one compilation)
+        self._predicted = _scan_predictor(model)
+
+    def plan(self, slam, rng: np.random.Generator) -> tuple[np.ndarray, dict]:
+        import jax
+        import jax.numpy as jnp
+
+        from cogmap.planning.mi_exploration import (
+            beam_endpoints,
+            candidate_controls,
+            obstacle_penalty_grid,
+            score_candidates,
+            truncate_at_collision,
+        )
+
+        t = slam.t
+        idx = rng.integers(0, t + 1, self.n_hist)
+        poses = slam.estimates[idx]
+        q = slam.params.q_map
+        if self.penalty_from == "predicted":  # Algorithm 2, l. 6: scans predicted by the map mean
+            x_hat = np.asarray(self._predicted(slam.params.emission, q.mean, jnp.asarray(poses)))
+        else:  # the scans the agent received there
+            x_hat = slam.scans[idx]
+        ends = beam_endpoints(poses, x_hat, self.model.lidar_range)
+        grid = obstacle_penalty_grid(ends, x_hat.size, self.extent, self.side)
+        self.key, k_c, k_s = jax.random.split(self.key, 3)
+        starts = slam.particles
+        cand = candidate_controls(k_c, starts, grid, self.extent, self.mi, sigma_t=self.model.sigma_t)
+        controls, free = truncate_at_collision(cand.controls, slam.estimate, grid, self.extent)
+        scores = score_candidates(k_s, q, slam.params.emission, self.model, starts, controls, self.mi)
+        best = int(np.argmax(scores))
+        return controls[best], {"scores": scores, "best": best, "penalty": cand.penalty, "grid": grid,
+                                "controls": controls, "free_steps": free, "starts": np.asarray(starts)}
+
+
+def cache_dir():
+    """Where the pretrained emission is kept between runs (``$XDG_CACHE_HOME/cogmap``, else ``~/.cache/cogmap``)."""
+    import os
+    from pathlib import Path
+
+    return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "cogmap"
+
+
+def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters: int = 1500):
+    """The emission network trained with known poses on a traversal of maze 0 (moderate / medium), as
+    ``cogmap dvbf slam`` does; cached in ``cache_dir`` (npz + JSON) when given, since every run of a
+    study uses the same one."""
+    from pathlib import Path
+
+    from cogmap.envs.maze import make_maze
+    from cogmap.envs.maze_traversal import traverse
+    from cogmap.genmodel.dvbf import DVBFConfig
+
+    from .run import load_params, save_params
+    from .slam import pretrain_emission
+
+    cache = None
+    if cache_dir is not None:
+        cache = Path(cache_dir) / f"emission-maze0-s{seed}-{steps}-{iters}"
+        if (cache / "model.json").is_file():
+            return load_params(cache)[0].emission
+    maze = make_maze(0)
+    tr = traverse(maze, steps, seed=seed + 1000, noise=NOISE)
+    model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64, sigma_t=(0.0005, 0.0005, NOISE.rot_std))
+    emission, _ = pretrain_emission(tr.poses, tr.scans, model, iters=iters, seed=seed)
+    if cache is not None:
+        import tempfile
+
+        from cogmap.inference.elbo import init_params
+
+        cache.parent.mkdir(parents=True, exist_ok=True)
+        tmp = Path(tempfile.mkdtemp(dir=cache.parent))
+        import jax
+
+        save_params(init_params(model, jax.random.PRNGKey(0))._replace(emission=emission), model, tmp)
+        try:
+            tmp.rename(cache)
+        except OSError:  # another process wrote it first
+            pass
+    return emission
+
+
+def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=None) -> ExploreResult:
+    """Run one exploration of ``steps`` time steps (the start pose counts as step 0)."""
+    import dataclasses
+
+    if steps < 2:
+        raise ValueError(f"explore: steps must be >= 2, got {steps}")
+    sim = MazeSim(maze, noise=NOISE, seed=cfg.seed + 1)
+    tic = time.perf_counter()
+    try:
+        pose = sim.reset(start_pose(maze, cfg.seed))
+        scan = sim.lidar()
+        poses, controls, scans = [pose], [], [scan]
+        slam = planner = None
+        use_slam = cfg.method == "mi" or cfg.learn_map
+        if use_slam:
+            from cogmap.genmodel.dvbf import DVBFConfig
+            from cogmap.genmodel.latent_map import kl_map
+
+            from .slam import OnlineSLAM, SLAMConfig
+
+            model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64,
+                               sigma_t=(0.0005, 0.0005, NOISE.rot_std))
+            sc = SLAMConfig(model=model, seed=cfg.seed, train_every=cfg.train_every, train_iters=cfg.train_iters,
+                            freeze_emission=emission is not None)
+            slam = OnlineSLAM(pose, sc, steps + cfg.train_every, emission=emission, first_scan=scan)
+        if cfg.method == "mi":
+            mi = cfg.mi if cfg.mi.max_step == cfg.max_step and cfg.mi.max_turn == cfg.max_turn else \
+                dataclasses.replace(cfg.mi, max_step=cfg.max_step, max_turn=cfg.max_turn)
+            planner = MIPlanner(model, mi, maze.size, cfg.seed, cfg.penalty_from)
+        policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
+                  else Frontier(maze, cfg, cfg.seed, sim.lidar_range) if cfg.method == "frontier" else None)
+        rng = np.random.default_rng([cfg.seed, 5])
+        ratio_curve, info_curve, plan_seconds = [(0, exploration_ratio(maze, pose))], [], []
+        tiles = {tuple(r) for r in maze.tile_index(pose)}
+        if slam is not None:
+            info_curve.append((0, float(kl_map(slam.params.q_map))))
+        queue: list[np.ndarray] = []
+        blocked = n_blocked = 0
+        for t in range(1, steps):
+            if planner is not None:
+                if not queue:
+                    slam.flush()  # plan from the latest pose posterior
+                    t0 = time.perf_counter()
+                    u_best, info = planner.plan(slam, rng)
+                    plan_seconds.append(time.perf_counter() - t0)
+                    # execute up to the predicted collision, rounded up to whole filter chunks (standing after it)
+                    free = int(info["free_steps"][info["best"]])
+                    n = min(cfg.replan_every, cfg.train_every * max(1, -(-free // cfg.train_every)))
+                    queue = list(u_best[:n])
+                u = queue.pop(0)
+            else:
+                u = policy.act(pose, scan, bool(blocked))
+            pose, blocked = sim.step(u)
+            scan = sim.lidar()
+            n_blocked += int(blocked)
+            poses.append(pose)
+            controls.append(np.asarray(u, float))
+            scans.append(scan)
+            tiles.add(tuple(maze.tile_index(pose)[0]))
+            if slam is not None:
+                # a bump sensor tells the agent that a wall stopped it: the filter then sees no translation
+                # (the distance moved before the wall is not known to it)
+                slam.advance(np.array([u[0], 0.0 if blocked else u[1]])[None], scan[None])
+            if blocked and planner is not None:
+                # the plan ran into a wall: stand (turning as planned) until the next filter chunk, then re-plan
+                queue = [np.array([v[0], 0.0]) for v in queue[: (-t) % cfg.train_every]]
+            if t % cfg.curve_every == 0 or t == steps - 1:
+                ratio_curve.append((t, len(tiles) / maze.tiles**2))
+                if slam is not None and slam.t == t and t % (10 * cfg.curve_every) == 0:
+                    info_curve.append((t, float(kl_map(slam.params.q_map))))
+            if progress is not None:
+                progress(t)
+        est = None
+        if slam is not None:
+            slam.flush()
+            est = slam.estimates[:steps].copy()
+            if info_curve[-1][0] != steps - 1:
+                info_curve.append((steps - 1, float(kl_map(slam.params.q_map))))
+        return ExploreResult(np.array(poses), np.array(controls), np.array(scans), est, ratio_curve, info_curve,
+                             plan_seconds, n_blocked, params=slam.params if slam else None,
+                             model=slam.config.model if slam else None, seconds=time.perf_counter() - tic)
+    finally:
+        sim.close()
+
+
+def ratio_at(curve, step: int) -> float:
+    """The exploration ratio of a ``[(step, ratio)]`` curve at ``step`` (the last point at or before it)."""
+    best = 0.0
+    for s, r in curve:
+        if s <= step:
+            best = r
+    return best
