@@ -175,6 +175,10 @@ class Done:
         self.agent, self.patience, self.quiet, self.seen = agent, patience, 0, (0, 0)
         self.seen_all = 0
 
+    #: end reasons (``reason``); ``BUDGET`` when the run ran out of decisions before the agent ended it
+    NOTHING_LEFT = "nothing reachable left unseen"
+    BUDGET = "budget"
+
     def __call__(self, decision) -> bool:
         a = self.agent
         seen = (a.num_states, int(a.visited().sum())) if a.model is not None else (0, 0)
@@ -192,6 +196,25 @@ class Done:
     def finished(self) -> bool:
         """The agent has declared its exploration over."""
         return self.patience > 0 and (self.quiet >= self.patience or self.seen_all >= self.SEEN_ALL)
+
+    @property
+    def reason(self) -> str:
+        """Why the exploration ended (or would end now): :data:`NOTHING_LEFT`, ``"no map growth for
+        N decisions"`` or :data:`BUDGET` (the agent did not end it)."""
+        if self.patience > 0 and self.seen_all >= self.SEEN_ALL:
+            return self.NOTHING_LEFT
+        if self.patience > 0 and self.quiet >= self.patience:
+            return f"no map growth for {self.patience} decisions"
+        return self.BUDGET
+
+    def summary(self) -> dict:
+        """The end of exploration for ``metrics.json`` and the study rows: ``ended_by_agent``,
+        ``end_reason`` and ``unvisited_reachable`` (states the agent predicts and believes reachable
+        but never visited, :func:`cogmap.agent.liveness.unvisited_reachable`)."""
+        from cogmap.agent.liveness import unvisited_reachable
+
+        return {"ended_by_agent": self.finished, "end_reason": self.reason,
+                "unvisited_reachable": unvisited_reachable(self.agent)}
 
 
 CHECKPOINT = "checkpoint"
@@ -291,7 +314,7 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
         ep = run_episode(sim, AgentPolicy(agent), steps - len(ep.rows), progress=progress, episode=ep, stop=done,
                          desc="explore", after_step=checkpoint if out is not None else None, moved=moved,
                          distance=distance)
-        metrics = {**episode_metrics(sim, ep), "ended_by_agent": done.finished}
+        metrics = {**episode_metrics(sim, ep), **done.summary()}
         if out is not None:
             write_run(out, sim, agent, ep, metrics)
             import shutil

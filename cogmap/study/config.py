@@ -8,7 +8,8 @@ import json
 
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
-STUDIES = ("exploration", "success", "goals", "drift", "slip", "dropout", "obstacle", "scaling", "drone")
+STUDIES = ("exploration", "generalisation", "success", "goals", "drift",
+           "slip", "dropout", "obstacle", "scaling", "drone")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -82,6 +83,21 @@ DRIFT_LEVELS = {
 
 FAULTS = ("none", "lidar", "camera")  # dropout study: which stream is silent
 
+# generalisation study: procedural buildings (cogmap.envs.buildings) from seeds no test uses (the
+# tests use 0-49), kinds cycled; budget 300 decisions, as the largest shipped layouts
+GENERAL_SEED0 = 1000
+GENERAL_BUILDINGS = {"full": 20, "reduced": 4}
+GENERAL_STEPS = 300
+GENERAL_METHODS = ("aimapp", "frontier", "oracle")
+
+
+def building_envs(count: int, first_seed: int = GENERAL_SEED0) -> list[str]:
+    """``count`` procedural buildings ``building:KIND:SEED`` with seeds ``first_seed, first_seed+1, ...``
+    and the kinds cycled in the order of :data:`cogmap.envs.buildings.KINDS`."""
+    from cogmap.envs.buildings import KINDS
+
+    return [f"building:{KINDS[i % len(KINDS)]}:{first_seed + i}" for i in range(count)]
+
 
 def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
     """Environments, methods, seeds and parameters of a study at a scale."""
@@ -104,6 +120,11 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
                                else ("aimapp", "frontier", "frontier_paper", "random"))
         plan["seeds"] = list(range(5 if full else 3))
         plan["steps"] = STEPS_FULL if full else STEPS_REDUCED
+    elif study == "generalisation":  # issue 15, item 5: layouts the agent was never tuned on
+        plan["envs"] = building_envs(GENERAL_BUILDINGS["full" if full else "reduced"])
+        plan["methods"] = list(GENERAL_METHODS)
+        plan["seeds"] = list(range(3 if full else 1))
+        plan["steps"] = {e: GENERAL_STEPS for e in plan["envs"]}
     elif study == "goals":
         plan["envs"] = list(("mini_warehouse", "small_warehouse", "house", "large_warehouse") if full
                             else ("mini_warehouse", "small_warehouse"))
@@ -157,7 +178,8 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         plan["seeds"] = list(seeds)
     if methods is not None:
         plan["methods"] = list(methods)
-    plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, 100))) for e in plan["envs"]}
+    default = GENERAL_STEPS if study == "generalisation" else 100
+    plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, default))) for e in plan["envs"]}
     if study in ("obstacle", "scaling"):
         plan["stop_rule"] = FIXED_STEPS
     return plan
