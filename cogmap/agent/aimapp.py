@@ -111,6 +111,10 @@ class AIMAPPAgent:
         self.frame = SE2()  # odometry frame -> belief frame (drift correction, section 3.3)
         self.anchors: dict[int, Anchor] = {}  # state -> view and scan of its first confident visit
         self.corrections = 0  # accepted drift corrections
+        # every move of the belief frame: {"step", "kind", "moved_m"}, kind "correction" (_correct) or
+        # "relocalisation" (_update: found again after being lost, or a recognised view without LiDAR);
+        # moved_m = how far the believed position of the robot moved (m)
+        self.frame_moves: list[dict] = []
         self.last: Decision | None = None
         self.goal_obs: int | None = None
         self.step_count = 0
@@ -202,9 +206,13 @@ class AIMAPPAgent:
         obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
         q, conf = self._infer(obs, pose)
         if self._correct(q, conf, local, pose):  # a recognised place moved the belief frame
+            self._record_frame_move("correction", pose, sensed.odometry)
             pose = self.believed_pose(sensed.odometry)
             local = self._to_belief(sensed)
+        frame = self.frame
         expanded = self._update(q, conf, obs, local, pose, score)
+        if self.frame is not frame:
+            self._record_frame_move("relocalisation", pose, sensed.odometry)
         if not self.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
             self.views.observe(self, sensed)
             if conf.confident:
@@ -213,6 +221,11 @@ class AIMAPPAgent:
         decision.missing = missing
         self.last, self._outcome = decision, None
         return decision
+
+    def _record_frame_move(self, kind: str, before, odometry) -> None:
+        """Note in :attr:`frame_moves` how far the belief frame's change moved the believed position."""
+        moved = float(np.hypot(*(self.believed_pose(odometry) - np.asarray(before)[:2])))
+        self.__dict__.setdefault("frame_moves", []).append({"step": self.step_count, "kind": kind, "moved_m": moved})
 
     # -- the cycle -------------------------------------------------------------------------
     def _paused(self, sensed: Sensed) -> Decision:

@@ -24,11 +24,14 @@ AIMAPP_VARIANTS = {"aimapp_revisits": {"track_anchors": False}}
 STOP_RULE = "own end or decision budget"
 FIXED_STEPS = "fixed number of decisions"  # obstacle and scaling studies follow one run for a set time
 AIMAPP_PATIENCE = 20
+# AIMAPP's end rule (cogmap.explore.Done): "liveness" (informative states without a believed path do
+# not end it; a pursued target extends the patience threefold) or the earlier "seen-all"
+AIMAPP_END_RULE = "liveness"
 
 # options of each method that change its runs (part of every run's key); see method_options()
 METHOD_OPTIONS = {
-    "aimapp": {"patience": AIMAPP_PATIENCE},
-    "aimapp_revisits": {"patience": AIMAPP_PATIENCE},
+    "aimapp": {"patience": AIMAPP_PATIENCE, "end_rule": AIMAPP_END_RULE},
+    "aimapp_revisits": {"patience": AIMAPP_PATIENCE, "end_rule": AIMAPP_END_RULE},
     "frontier": {"goal": "nearest reachable cell"},
     "frontier_paper": {"goal": "centroid"},
     "random": {},

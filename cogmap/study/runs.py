@@ -96,15 +96,16 @@ def make_policy(method: str, sim, step: float, seed: int, config: dict | None = 
 
 
 def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None,
-                    config: dict | None = None, faults=(), end: dict | None = None):
+                    config: dict | None = None, faults=(), end: dict | None = None, end_rule: str | None = None):
     """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
     ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim.
+    ``end_rule`` is AIMAPP's (:class:`cogmap.explore.Done`; default ``config.AIMAPP_END_RULE``).
     ``end``, if given, receives ``end_reason`` and (AIMAPP) ``unvisited_reachable`` (:meth:`Done.summary`)."""
     from cogmap.agent.aimapp import AIMAPPAgent
     from cogmap.baselines import run_policy
     from cogmap.explore import Done, default_config, run_agent
 
-    from .config import AIMAPP_PATIENCE
+    from .config import AIMAPP_END_RULE, AIMAPP_PATIENCE
 
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
@@ -114,7 +115,8 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
         from .config import aimapp_config
 
         agent = AIMAPPAgent(aimapp_config(method, env), seed=seed)
-        done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
+        done = Done(agent, AIMAPP_PATIENCE if patience is None else patience,  # the agent's own end
+                    end_rule or AIMAPP_END_RULE)
         ep = run_agent(sim, agent, steps, progress=False, stop=done)
         if end is not None:
             end.update({k: v for k, v in done.summary().items() if k != "ended_by_agent"})
@@ -177,7 +179,7 @@ def run_exploration(spec) -> dict:
     config = opts.get("config") if not spec["method"].startswith("aimapp") else None
     end: dict = {}
     sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
-                                        opts.get("patience"), config, _faults(spec), end)
+                                        opts.get("patience"), config, _faults(spec), end, opts.get("end_rule"))
     try:
         return exploration_result(spec, sim, ep, ended, end)
     finally:
