@@ -126,6 +126,9 @@ class AIMAPPAgent:
         self.relocalisations = 0
         self.views = ViewMap(self.cfg)  # what the LiDAR has sensed (exploration planning only)
         self.scanned: set[int] = set()  # states the agent has stood on with its LiDAR reporting
+        # (state, heading, state) moves the robot has driven (and their reverses): their way is known
+        # passable, so only an obstacle within the robot's own width blocks them (_path_blocked)
+        self.traversed: set[tuple[int, int, int]] = set()
 
     # -- public ------------------------------------------------------------------------------
     @property
@@ -462,6 +465,9 @@ class AIMAPPAgent:
         if last is not None and self._outcome and state != last.state and last.action != cfg.stay:
             learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
                              reverse_control=self._reverse(last.action), rates=cfg.learning)
+            traversed = self.__dict__.setdefault("traversed", set())
+            traversed.add((int(last.state), int(last.action), state))
+            traversed.add((state, int(self._reverse(last.action)), int(last.state)))
         if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
             return 0
         return self._expand(state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan, pose)
@@ -485,14 +491,23 @@ class AIMAPPAgent:
         return out
 
     def _path_blocked(self, heading: int, target: int, obstacles: np.ndarray, scan: np.ndarray | None,
-                      pose: np.ndarray) -> bool:
+                      pose: np.ndarray, state: int | None = None) -> bool:
         """Would the move toward ``target`` collide? With a scan, its corridor is checked along
         the actual bearing and length from ``pose`` to the target (what the robot will drive);
-        otherwise the heading's flag is used."""
+        otherwise the heading's flag is used. The corridor is the robot's width plus
+        ``obstacle_margin``, except for a move from ``state`` the robot has driven before (either
+        way, :attr:`traversed`): a return within the margin alone does not block a way known
+        passable (else a doorway passed near its jamb would cut the map in two), while anything
+        within the robot's own width (e.g. a box moved onto the way) still does."""
         if scan is None:
             return bool(obstacles[heading])
         cfg = self.cfg
-        return bool(blocked(scan, self.poses[target] - pose, cfg.robot_radius + cfg.obstacle_margin)[0])
+        move = self.poses[target] - pose
+        if not blocked(scan, move, cfg.robot_radius + cfg.obstacle_margin)[0]:
+            return False
+        if state is not None and (int(state), int(heading), int(target)) in getattr(self, "traversed", ()):
+            return bool(blocked(scan, move, cfg.robot_radius)[0])
+        return True
 
     def _move_obstacles(self, state: int, obstacles: np.ndarray | None, scan: np.ndarray | None,
                         pose: np.ndarray) -> np.ndarray:
@@ -507,7 +522,7 @@ class AIMAPPAgent:
         for h in range(self.cfg.num_headings):
             target, _ = self._waypoint(state, h)
             if target != state:
-                flags[h] = self._path_blocked(h, target, obstacles, scan, pose)
+                flags[h] = self._path_blocked(h, target, obstacles, scan, pose, state)
         return flags
 
     def _expand(self, state: int, obstacles: np.ndarray, scan: np.ndarray | None, pose: np.ndarray) -> int:
@@ -524,7 +539,7 @@ class AIMAPPAgent:
             n = int(neighbours[h])
             believed = {int(t) for t, p in zip(B.succ[state, h], B.prob[state, h], strict=True) if p > 0}
             for t in sorted((believed | {n}) - {state, -1}):  # states this move is believed to reach
-                free = not self._path_blocked(h, t, obstacles, scan, pose)
+                free = not self._path_blocked(h, t, obstacles, scan, pose, state)
                 event = Event.PREDICTED_POSSIBLE if free and t == n else Event.PREDICTED_IMPOSSIBLE
                 if free and t != n:
                     continue  # another state now lies in that direction: leave this link alone
