@@ -116,7 +116,7 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
                   "success_rule": SuccessRule().to_dict(), "aimapp_patience": AIMAPP_PATIENCE,
-                  "params": {}}
+                  "aimapp_end_rule": AIMAPP_END_RULE, "params": {}}
     if study in ("exploration", "success"):
         plan["envs"] = list(ALL_ENVS if full else ("mini_warehouse", "small_warehouse"))
         plan["methods"] = list(METHODS if study == "exploration"

@@ -106,9 +106,16 @@ def protocol_note(plan, results, endpoint: str, success: bool = True) -> str:
 
     rule = plan.get("stop_rule", "?")
     if rule == STOP_RULE:
-        rule += (" (AIMAPP's own end: its LiDAR map shows nothing reachable left to see for 3 decisions, or no map "
-                 f"growth and no first visit for {plan.get('aimapp_patience', 20)} decisions; frontiers: no frontier "
-                 "left; oracle: nothing worth a detour; random walk: budget only)")
+        n = plan.get("aimapp_patience", 20)
+        if plan.get("aimapp_end_rule") == "liveness":
+            own = (f"its LiDAR map shows no state left whose view would reveal unseen area for 3 decisions, or no map "
+                   f"growth and no first visit for {n} decisions while no informative state is reachable over "
+                   f"believed transitions, or for {3 * n} decisions while one is pursued (a loop)")
+        else:
+            own = (f"its LiDAR map shows nothing reachable left to see for 3 decisions, or no map growth and no first "
+                   f"visit for {n} decisions")
+        rule += (f" (AIMAPP's own end: {own}; frontiers: no frontier left; oracle: nothing worth a detour; "
+                 "random walk: budget only)")
     lines = [f"**Endpoint:** {endpoint}",
              f"**Run end:** {rule}. Budgets (decisions): " + ", ".join(f"{e} {n}" for e, n in plan["steps"].items())
              + ".",
