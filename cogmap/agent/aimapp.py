@@ -223,6 +223,10 @@ class AIMAPPAgent:
         self.frame = SE2()  # odometry frame -> belief frame (drift correction, section 3.3)
         self.anchors: dict[int, Anchor] = {}  # state -> view and scan of its first confident visit
         self.corrections = 0  # accepted drift corrections
+        # every move of the belief frame: {"step", "kind", "moved_m"}, kind "correction" (_correct) or
+        # "relocalisation" (_update: found again after being lost, or a recognised view without LiDAR);
+        # moved_m = how far the believed position of the robot moved (m)
+        self.frame_moves: list[dict] = []
         self.last: Decision | None = None
         self.goal_obs: int | None = None
         self.step_count = 0
@@ -234,6 +238,9 @@ class AIMAPPAgent:
         self.relocalisations = 0
         self.views = ViewMap(self.cfg)  # what the LiDAR has sensed (exploration planning only)
         self.scanned: set[int] = set()  # states the agent has stood on with its LiDAR reporting
+        # (state, heading, state) moves the robot has driven (and their reverses): their way is known
+        # passable, so only an obstacle within the robot's own width blocks them (_path_blocked)
+        self.traversed: set[tuple[int, int, int]] = set()
 
     # -- public ------------------------------------------------------------------------------
     @property
@@ -400,9 +407,13 @@ class AIMAPPAgent:
         obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
         q, conf = self._infer(obs, pose)
         if self._correct(q, conf, local, pose):  # a recognised place moved the belief frame
+            self._record_frame_move("correction", pose, sensed.odometry)
             pose = self.believed_pose(sensed.odometry)
             local = self._to_belief(sensed)
+        frame = self.frame
         expanded = self._update(q, conf, obs, local, pose, score)
+        if self.frame is not frame:
+            self._record_frame_move("relocalisation", pose, sensed.odometry)
         if not self.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
             self.views.observe(self, sensed)
             if conf.confident:
@@ -411,6 +422,11 @@ class AIMAPPAgent:
         decision.missing = missing
         self.last, self._outcome = decision, None
         return decision
+
+    def _record_frame_move(self, kind: str, before, odometry) -> None:
+        """Note in :attr:`frame_moves` how far the belief frame's change moved the believed position."""
+        moved = float(np.hypot(*(self.believed_pose(odometry) - np.asarray(before)[:2])))
+        self.__dict__.setdefault("frame_moves", []).append({"step": self.step_count, "kind": kind, "moved_m": moved})
 
     # -- the cycle -------------------------------------------------------------------------
     def _paused(self, sensed: Sensed) -> Decision:
@@ -660,6 +676,9 @@ class AIMAPPAgent:
         if last is not None and self._outcome and state != last.state and last.action != cfg.stay:
             learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
                              reverse_control=self._reverse(last.action), rates=cfg.learning)
+            traversed = self.__dict__.setdefault("traversed", set())
+            traversed.add((int(last.state), int(last.action), state))
+            traversed.add((state, int(self._reverse(last.action)), int(last.state)))
         if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
             return 0
         return self._expand(state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan, pose)
@@ -683,14 +702,23 @@ class AIMAPPAgent:
         return out
 
     def _path_blocked(self, heading: int, target: int, obstacles: np.ndarray, scan: np.ndarray | None,
-                      pose: np.ndarray) -> bool:
+                      pose: np.ndarray, state: int | None = None) -> bool:
         """Would the move toward ``target`` collide? With a scan, its corridor is checked along
         the actual bearing and length from ``pose`` to the target (what the robot will drive);
-        otherwise the heading's flag is used."""
+        otherwise the heading's flag is used. The corridor is the robot's width plus
+        ``obstacle_margin``, except for a move from ``state`` the robot has driven before (either
+        way, :attr:`traversed`): a return within the margin alone does not block a way known
+        passable (else a doorway passed near its jamb would cut the map in two), while anything
+        within the robot's own width (e.g. a box moved onto the way) still does."""
         if scan is None:
             return bool(obstacles[heading])
         cfg = self.cfg
-        return bool(blocked(scan, self.poses[target] - pose, cfg.robot_radius + cfg.obstacle_margin)[0])
+        move = self.poses[target] - pose
+        if not blocked(scan, move, cfg.robot_radius + cfg.obstacle_margin)[0]:
+            return False
+        if state is not None and (int(state), int(heading), int(target)) in getattr(self, "traversed", ()):
+            return bool(blocked(scan, move, cfg.robot_radius)[0])
+        return True
 
     def _move_obstacles(self, state: int, obstacles: np.ndarray | None, scan: np.ndarray | None,
                         pose: np.ndarray) -> np.ndarray:
@@ -705,7 +733,7 @@ class AIMAPPAgent:
         for h in range(self.cfg.num_headings):
             target, _ = self._waypoint(state, h)
             if target != state:
-                flags[h] = self._path_blocked(h, target, obstacles, scan, pose)
+                flags[h] = self._path_blocked(h, target, obstacles, scan, pose, state)
         return flags
 
     def _expand(self, state: int, obstacles: np.ndarray, scan: np.ndarray | None, pose: np.ndarray) -> int:
@@ -722,7 +750,7 @@ class AIMAPPAgent:
             n = int(neighbours[h])
             believed = {int(t) for t, p in zip(B.succ[state, h], B.prob[state, h], strict=True) if p > 0}
             for t in sorted((believed | {n}) - {state, -1}):  # states this move is believed to reach
-                free = not self._path_blocked(h, t, obstacles, scan, pose)
+                free = not self._path_blocked(h, t, obstacles, scan, pose, state)
                 event = Event.PREDICTED_POSSIBLE if free and t == n else Event.PREDICTED_IMPOSSIBLE
                 if free and t != n:
                     continue  # another state now lies in that direction: leave this link alone

@@ -26,7 +26,7 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
         gains = np.concatenate([gains, np.full(doubt.size, cfg.view_min_area)])
         beyond = np.concatenate([beyond, np.zeros(doubt.size)])
     if states.size == 0:
-        agent.views.target = -1
+        agent.views.target, agent.views.unreached = -1, 0
         return states
     steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth)[states].astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
@@ -35,6 +35,7 @@ def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np
     i = sensed.best_target(gains, steps + beyond / cfg.influence_radius, cfg.influence_radius, cfg.view_detour,
                            keep=keep, keep_ratio=cfg.view_keep_ratio)
     agent.views.target = int(states[i]) if i >= 0 else -1
+    agent.views.unreached = int(states.size) if i < 0 else 0  # informative states without a believed path
     return states[i:i + 1] if i >= 0 else states[:0]
 
 

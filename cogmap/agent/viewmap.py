@@ -25,6 +25,7 @@ class ViewMap:
         self._dirty_states = self._dirty_frontier = None  # box of cells changed since the last query
         self.doubt: set[int] = set()  # states beside a moved obstacle, preferred until visited
         self.target = -1  # state pursued by the inductive term (kept while nearly the best)
+        self.unreached = 0  # states that promise information but no believed-possible path reaches
         self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
 
     def observe(self, agent, sensed) -> None:

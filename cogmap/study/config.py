@@ -8,8 +8,8 @@ import json
 
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
-STUDIES = ("exploration", "success", "goals", "drift", "slip", "dropout", "obstacle", "scaling", "drone",
-           "dvbf-navigation", "dvbf-exploration")
+STUDIES = ("exploration", "generalisation", "success", "goals", "drift", "slip", "dropout", "obstacle",
+           "scaling", "drone", "dvbf-navigation", "dvbf-exploration")
 METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -24,11 +24,14 @@ AIMAPP_VARIANTS = {"aimapp_revisits": {"track_anchors": False}}
 STOP_RULE = "own end or decision budget"
 FIXED_STEPS = "fixed number of decisions"  # obstacle and scaling studies follow one run for a set time
 AIMAPP_PATIENCE = 20
+# AIMAPP's end rule (cogmap.explore.Done): "liveness" (informative states without a believed path do
+# not end it; a pursued target extends the patience threefold) or the earlier "seen-all"
+AIMAPP_END_RULE = "liveness"
 
 # options of each method that change its runs (part of every run's key); see method_options()
 METHOD_OPTIONS = {
-    "aimapp": {"patience": AIMAPP_PATIENCE},
-    "aimapp_revisits": {"patience": AIMAPP_PATIENCE},
+    "aimapp": {"patience": AIMAPP_PATIENCE, "end_rule": AIMAPP_END_RULE},
+    "aimapp_revisits": {"patience": AIMAPP_PATIENCE, "end_rule": AIMAPP_END_RULE},
     "frontier": {"goal": "nearest reachable cell"},
     "frontier_paper": {"goal": "centroid"},
     "random": {},
@@ -83,6 +86,21 @@ DRIFT_LEVELS = {
 
 FAULTS = ("none", "lidar", "camera")  # dropout study: which stream is silent
 
+# generalisation study: procedural buildings (cogmap.envs.buildings) from seeds no test uses (the
+# tests use 0-49), kinds cycled; budget 300 decisions, as the largest shipped layouts
+GENERAL_SEED0 = 1000
+GENERAL_BUILDINGS = {"full": 20, "reduced": 4}
+GENERAL_STEPS = 300
+GENERAL_METHODS = ("aimapp", "frontier", "oracle")
+
+
+def building_envs(count: int, first_seed: int = GENERAL_SEED0) -> list[str]:
+    """``count`` procedural buildings ``building:KIND:SEED`` with seeds ``first_seed, first_seed+1, ...``
+    and the kinds cycled in the order of :data:`cogmap.envs.buildings.KINDS`."""
+    from cogmap.envs.buildings import KINDS
+
+    return [f"building:{KINDS[i % len(KINDS)]}:{first_seed + i}" for i in range(count)]
+
 
 def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
     """Environments, methods, seeds and parameters of a study at a scale."""
@@ -107,13 +125,18 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
                   "success_rule": SuccessRule().to_dict(), "aimapp_patience": AIMAPP_PATIENCE,
-                  "params": {}}
+                  "aimapp_end_rule": AIMAPP_END_RULE, "params": {}}
     if study in ("exploration", "success"):
         plan["envs"] = list(ALL_ENVS if full else ("mini_warehouse", "small_warehouse"))
         plan["methods"] = list(METHODS if study == "exploration"
                                else ("aimapp", "frontier", "frontier_paper", "random"))
         plan["seeds"] = list(range(5 if full else 3))
         plan["steps"] = STEPS_FULL if full else STEPS_REDUCED
+    elif study == "generalisation":  # issue 15, item 5: layouts the agent was never tuned on
+        plan["envs"] = building_envs(GENERAL_BUILDINGS["full" if full else "reduced"])
+        plan["methods"] = list(GENERAL_METHODS)
+        plan["seeds"] = list(range(3 if full else 1))
+        plan["steps"] = {e: GENERAL_STEPS for e in plan["envs"]}
     elif study == "goals":
         plan["envs"] = list(("mini_warehouse", "small_warehouse", "house", "large_warehouse") if full
                             else ("mini_warehouse", "small_warehouse"))
@@ -167,7 +190,8 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         plan["seeds"] = list(seeds)
     if methods is not None:
         plan["methods"] = list(methods)
-    plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, 100))) for e in plan["envs"]}
+    default = GENERAL_STEPS if study == "generalisation" else 100
+    plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, default))) for e in plan["envs"]}
     if study in ("obstacle", "scaling"):
         plan["stop_rule"] = FIXED_STEPS
     return plan

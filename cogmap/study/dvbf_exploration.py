@@ -185,7 +185,7 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
             "learnt map, candidate optimisation, MI of every candidate), wall clock on this shared 2-core machine. "
             "MI settings of the study (not the paper's, which are about 100 times heavier): "
             f"{asdict_short(plan)}. Mean ± std over seeds; the shaded band in ratio.png is one std.")
-    return (_md(header, rows) + "\n\n**Target (issue 12): MI above the random walk in every complexity level.**\n\n"
+    return (_md(header, rows) + "\n\n**Target: MI above the random walk in every complexity level.**\n\n"
             + "\n".join(verdict) + "\n\n" + note + "\n\n![exploration ratio](ratio.png)\n")
 
 

@@ -106,9 +106,16 @@ def protocol_note(plan, results, endpoint: str, success: bool = True) -> str:
 
     rule = plan.get("stop_rule", "?")
     if rule == STOP_RULE:
-        rule += (" (AIMAPP's own end: its LiDAR map shows nothing reachable left to see for 3 decisions, or no map "
-                 f"growth and no first visit for {plan.get('aimapp_patience', 20)} decisions; frontiers: no frontier "
-                 "left; oracle: nothing worth a detour; random walk: budget only)")
+        n = plan.get("aimapp_patience", 20)
+        if plan.get("aimapp_end_rule") == "liveness":
+            own = (f"its LiDAR map shows no state left whose view would reveal unseen area for 3 decisions, or no map "
+                   f"growth and no first visit for {n} decisions while no informative state is reachable over "
+                   f"believed transitions, or for {3 * n} decisions while one is pursued (a loop)")
+        else:
+            own = (f"its LiDAR map shows nothing reachable left to see for 3 decisions, or no map growth and no first "
+                   f"visit for {n} decisions")
+        rule += (f" (AIMAPP's own end: {own}; frontiers: no frontier left; oracle: nothing worth a detour; "
+                 "random walk: budget only)")
     lines = [f"**Endpoint:** {endpoint}",
              f"**Run end:** {rule}. Budgets (decisions): " + ", ".join(f"{e} {n}" for e, n in plan["steps"].items())
              + ".",
@@ -203,8 +210,12 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
     plt = _plt()
     envs = plan["envs"]
     level = plan.get("coverage_level", 0.9)
-    fig, axes = plt.subplots(1, len(envs), figsize=(4.5 * len(envs), 3.6), squeeze=False)
-    for ax, env in zip(axes[0], envs, strict=True):
+    ncols = len(envs) if len(envs) <= 8 else 5  # many layouts (generalisation study): a grid of panels
+    nrows = -(-len(envs) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.5 * ncols, 3.6 * nrows), squeeze=False)
+    for ax in axes.flat[len(envs):]:
+        ax.set_visible(False)
+    for ax, env in zip(axes.flat, envs, strict=False):
         for method in plan["methods"]:
             for i, r in enumerate(groups.get((env, method), [])):
                 c = r["result"]["curve"]
@@ -235,12 +246,81 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
         ax.bar(np.arange(len(envs)) + j * w, means, w, yerr=stds, color=COLORS.get(method),
                label=METHOD_LABEL[method], capsize=2)
     ax.set_xticks(np.arange(len(envs)) + w * (len(plan["methods"]) - 1) / 2)
-    ax.set_xticklabels(envs, fontsize=8)
+    ax.set_xticklabels(envs, fontsize=8, rotation=60 if len(envs) > 8 else 0, ha="right" if len(envs) > 8 else "center")
     ax.set_ylabel(f"CE at {level:.0%} coverage (m²/m)\nsuccessful runs")
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, frameon=False)
     fig.tight_layout()
     fig.savefig(study_dir / "coverage_efficiency.png", dpi=110)
     plt.close(fig)
+
+
+# ---------------------------------------------------------------------------- generalisation
+#: issue 15's target over the procedural family: AIMAPP reaches the coverage level in at least this
+#: fraction of runs, with a mean CE at that level at least this multiple of the oracle's
+GENERAL_TARGET = {"reached": 0.95, "ce_ratio": 0.9}
+
+
+def pooled_rows(plan, results) -> list[dict]:
+    """One summary per method over every layout and seed: runs reaching the coverage level, mean CE
+    there (over the runs that reached it), its ratio to the oracle's mean CE, end reasons and the
+    predicted-but-unvisited reachable states left at the end (AIMAPP)."""
+    by_method = _groups(results, "method")
+    ce = {m: summarise([_ep(r["result"], "lvl", "ce") for r in by_method.get((m,), [])]) for m in plan["methods"]}
+    oracle = ce.get("oracle", {}).get("mean")
+    out = []
+    for m in plan["methods"]:
+        rs = [r["result"] for r in by_method.get((m,), [])]
+        if not rs:
+            continue
+        reasons: dict[str, int] = {}
+        for r in rs:
+            key = r.get("end_reason") or ("own end" if r["ended_by_itself"] else "budget")
+            reasons[key] = reasons.get(key, 0) + 1
+        left = [r.get("unvisited_reachable") for r in rs if r.get("unvisited_reachable") is not None]
+        out.append({"method": m, "runs": len(rs), "reached": sum(r.get("at_level") is not None for r in rs),
+                    "success": sum(bool(r["success"]) for r in rs), "ce": ce[m],
+                    "ratio": None if oracle is None or ce[m]["mean"] is None else ce[m]["mean"] / oracle,
+                    "coverage": summarise([r["coverage"] for r in rs]), "reasons": reasons,
+                    "left": summarise(left), "left_runs": sum(v > 0 for v in left) if left else None})
+    return out
+
+
+def generalisation_report(study_dir: Path, plan, results) -> str:
+    """The exploration table per building, then every method pooled over the buildings against the
+    issue's target (:data:`GENERAL_TARGET`)."""
+    table = exploration_report(study_dir, plan, results)
+    level = plan.get("coverage_level", 0.9)
+    pct = f"{level:.0%}"
+    header = ["Method", "runs", f"reached {pct}", "success", f"mean CE@{pct} (all that reached)",
+              "ratio to oracle", "coverage end", "end reasons",
+              "predicted unvisited reachable at end (mean; runs with any)"]
+    rows = []
+    pooled = pooled_rows(plan, results)
+    for p in pooled:
+        rows.append([METHOD_LABEL[p["method"]], p["runs"],
+                     f"{p['reached']}/{p['runs']} ({p['reached'] / p['runs']:.0%})",
+                     f"{p['success']}/{p['runs']}", _pm(p["ce"]), "–" if p["ratio"] is None else f"{p['ratio']:.2f}",
+                     _pm(p["coverage"], 3), "; ".join(f"{k}: {v}" for k, v in sorted(p["reasons"].items())),
+                     "–" if p["left_runs"] is None else f"{_fmt(p['left']['mean'], 1)}; {p['left_runs']}/{p['runs']}"])
+    _csv(study_dir / "pooled.csv", header, rows)
+    verdict = ""
+    aim = next((p for p in pooled if p["method"] == "aimapp"), None)
+    if aim is not None:
+        frac = aim["reached"] / aim["runs"]
+        ok_reach = frac >= GENERAL_TARGET["reached"]
+        ok_ce = aim["ratio"] is not None and aim["ratio"] >= GENERAL_TARGET["ce_ratio"]
+        ratio = "–" if aim["ratio"] is None else f"{aim['ratio']:.2f}x"
+        verdict = (f"\n\n**Target:** AIMAPP reaches {pct} in >= {GENERAL_TARGET['reached']:.0%} of runs: "
+                   f"{frac:.0%} ({'met' if ok_reach else 'not met'}); mean CE@{pct} >= "
+                   f"{GENERAL_TARGET['ce_ratio']}x the oracle's: "
+                   f"{ratio} "
+                   f"({'met' if ok_ce else 'not met'}).")
+    kinds = sorted({e.split(":")[1] for e in plan["envs"] if e.startswith("building:")})
+    intro = (f"**Layouts:** {len(plan['envs'])} procedural buildings (`cogmap.envs.buildings`, kinds "
+             f"{', '.join(kinds)} cycled; building seeds {plan['envs'][0].split(':')[-1]}-"
+             f"{plan['envs'][-1].split(':')[-1]}, which no test uses) x {len(plan['seeds'])} seed(s) (start poses).")
+    return (intro + "\n\n## All buildings pooled\n\n" + _md(header, rows) + verdict
+            + "\n\n## Per building\n\n" + table)
 
 
 # ---------------------------------------------------------------------------- success
@@ -488,7 +568,8 @@ def scaling_report(study_dir: Path, plan, results) -> str:
             + "\n\n" + note)
 
 
-REPORTS = {"exploration": exploration_report, "success": success_report, "goals": goals_report,
+REPORTS = {"exploration": exploration_report, "generalisation": generalisation_report,
+           "success": success_report, "goals": goals_report,
            "drift": drift_report, "slip": drift_report, "dropout": dropout_report,
            "obstacle": obstacle_report, "scaling": scaling_report}
 

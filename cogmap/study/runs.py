@@ -96,14 +96,16 @@ def make_policy(method: str, sim, step: float, seed: int, config: dict | None = 
 
 
 def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None,
-                    config: dict | None = None, faults=()):
+                    config: dict | None = None, faults=(), end: dict | None = None, end_rule: str | None = None):
     """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
-    ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim."""
+    ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim.
+    ``end_rule`` is AIMAPP's (:class:`cogmap.explore.Done`; default ``config.AIMAPP_END_RULE``).
+    ``end``, if given, receives ``end_reason`` and (AIMAPP) ``unvisited_reachable`` (:meth:`Done.summary`)."""
     from cogmap.agent.aimapp import AIMAPPAgent
     from cogmap.baselines import run_policy
     from cogmap.explore import Done, default_config, run_agent
 
-    from .config import AIMAPP_PATIENCE
+    from .config import AIMAPP_END_RULE, AIMAPP_PATIENCE
 
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
@@ -113,15 +115,27 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
         from .config import aimapp_config
 
         agent = AIMAPPAgent(aimapp_config(method, env), seed=seed)
-        done = Done(agent, AIMAPP_PATIENCE if patience is None else patience)  # the agent's own end
+        done = Done(agent, AIMAPP_PATIENCE if patience is None else patience,  # the agent's own end
+                    end_rule or AIMAPP_END_RULE)
         ep = run_agent(sim, agent, steps, progress=False, stop=done)
+        if end is not None:
+            end.update({k: v for k, v in done.summary().items() if k != "ended_by_agent"})
         return sim, ep, agent, done.finished
     pol = make_policy(method, sim, cfg.influence_radius, seed, config)
     ep = run_policy(sim, pol, steps)
-    return sim, ep, pol, bool(ep.rows and ep.rows[-1]["mode"] == "done")
+    ended = bool(ep.rows and ep.rows[-1]["mode"] == "done")
+    if end is not None:
+        end.update({"end_reason": BASELINE_END.get(method, "own end") if ended else Done.BUDGET,
+                    "unvisited_reachable": None})
+    return sim, ep, pol, ended
 
 
-def exploration_result(spec, sim, ep, ended_by_itself: bool = False) -> dict:
+#: how a baseline declares itself finished (its ``mode == "done"``)
+BASELINE_END = {"frontier": "no frontier left", "frontier_paper": "no frontier left",
+                "oracle": "no viewpoint worth a detour"}
+
+
+def exploration_result(spec, sim, ep, ended_by_itself: bool = False, end: dict | None = None) -> dict:
     """Both endpoints (90 % coverage and end of run), interventions and success, drift, digest."""
     from cogmap.explore import default_config, episode_metrics
 
@@ -140,6 +154,7 @@ def exploration_result(spec, sim, ep, ended_by_itself: bool = False) -> dict:
         "distance_m": m["distance_m"], "steps": m["steps"], "ce": ends["end"]["ce"], "nauc": ends["end"]["nauc"],
         "nauc_budget_m": budget, "nauc_own_distance": m["nauc"],
         "at_level": ends["at_level"], "level_step": ends["level_index"], "ended_by_itself": ended_by_itself,
+        **(end or {}),
         "failed_moves": m["failed_moves"], "silent_decisions": sum(1 for r in ep.rows if r.get("missing")),
         "interventions": events, "mismatch_m": mismatch_m,
         "success": not events,
@@ -162,10 +177,11 @@ def run_exploration(spec) -> dict:
     opts = spec["method_options"]
     # AIMAPP runs with aimapp_config(method, env), which is what its spec records; a baseline's recorded config
     config = opts.get("config") if not spec["method"].startswith("aimapp") else None
+    end: dict = {}
     sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
-                                        opts.get("patience"), config, _faults(spec))
+                                        opts.get("patience"), config, _faults(spec), end, opts.get("end_rule"))
     try:
-        return exploration_result(spec, sim, ep, ended)
+        return exploration_result(spec, sim, ep, ended, end)
     finally:
         sim.close()
 
@@ -358,7 +374,8 @@ def run_dvbf_exploration(spec) -> dict:
     return run(spec)
 
 
-RUNNERS = {"exploration": run_exploration, "success": run_exploration, "goals": run_goals, "drift": run_drift,
+RUNNERS = {"exploration": run_exploration, "generalisation": run_exploration, "success": run_exploration,
+           "goals": run_goals, "drift": run_drift,
            "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
            "drone": run_drone, "dvbf-navigation": run_dvbf_navigation,
            "dvbf-exploration": run_dvbf_exploration}

@@ -159,6 +159,9 @@ def test_severe_drift_belief_stays_closer_to_the_truth_than_odometry():
     noise = OdometryNoise(slip=0.08, heading_bias=0.05)  # the drift study's severe level
     agent, err_b, err_o = _drift_run("aisle_warehouse", 1, 60, noise)
     assert agent.corrections >= 10
+    # every accepted correction is on record with how far it moved the believed position
+    moves = [m for m in agent.frame_moves if m["kind"] == "correction"]
+    assert len(moves) == agent.corrections and all(0.0 < m["moved_m"] < 2.0 for m in moves)
     assert err_o[-1] > 2.0  # the odometry has drifted by metres
     assert err_b[-1] < 0.25 * err_o[-1]
     assert np.sqrt(np.mean(err_b**2)) < 0.25 * np.sqrt(np.mean(err_o**2))
