@@ -33,7 +33,23 @@ def layout_name(env: str) -> str:
     """Accept a layout name (``mini_warehouse``), a registered id (``cogmap/MiniWarehouse-v0``), a
     procedural building (``building:office:3``, see :func:`building_spec`) or a layout file
     (``building.json`` or a ``plan.png``; returned as an absolute path, so a run's ``run.json`` finds
-    it again from anywhere)."""
+    it again from anywhere).
+
+    Parameters
+    ----------
+    env : str
+        What the user typed after ``--env``.
+
+    Returns
+    -------
+    str
+        The layout name, the ``building:KIND:SEED`` string, or the absolute path of the file.
+
+    Raises
+    ------
+    ValueError
+        For anything else (the message lists what is accepted).
+    """
     from cogmap.envs.layout_file import is_layout_file
     from cogmap.envs.layouts import LAYOUTS
     from cogmap.envs.registry import LAYOUT_IDS
@@ -52,7 +68,19 @@ def layout_name(env: str) -> str:
 
 
 def building_spec(env: str) -> tuple[str, int]:
-    """``building:KIND:SEED`` (a procedural building, :mod:`cogmap.envs.buildings`) as (kind, seed)."""
+    """``building:KIND:SEED`` (a procedural building, :mod:`cogmap.envs.buildings`) as (kind, seed).
+
+    Parameters
+    ----------
+    env : str
+        ``"building:KIND:SEED"``.
+
+    Returns
+    -------
+    kind : str
+        The building kind (corridor, office, L, T, U, hall).
+    seed : int
+        The building seed."""
     from cogmap.envs.buildings import KINDS
 
     parts = env.split(":")
@@ -63,7 +91,17 @@ def building_spec(env: str) -> tuple[str, int]:
 
 
 def resolve_layout(env: str):
-    """The :class:`~cogmap.envs.layouts.Layout` that ``env`` names (see :func:`layout_name`)."""
+    """The :class:`~cogmap.envs.layouts.Layout` that ``env`` names (see :func:`layout_name`).
+
+    Parameters
+    ----------
+    env : str
+        A layout name, registered id, ``building:KIND:SEED`` or layout file.
+
+    Returns
+    -------
+    Layout
+        The layout (a layout file is loaded and checked)."""
     from cogmap.envs import make_layout
     from cogmap.envs.layout_file import is_layout_file, load_layout
 
@@ -77,7 +115,17 @@ def resolve_layout(env: str):
 
 
 def default_config(env: str) -> AgentConfig:
-    """Influence radius 1 m in small rooms and the house (doorways), 2 m in large open ones (Table 6)."""
+    """Influence radius 1 m in small rooms and the house (doorways), 2 m in large open ones (Table 6).
+
+    Parameters
+    ----------
+    env : str
+        The environment, as for :func:`layout_name`.
+
+    Returns
+    -------
+    AgentConfig
+        The agent's configuration for that environment."""
     large = layout_name(env) in ("large_warehouse", "parking_lot", "aisle_warehouse")
     return AgentConfig(influence_radius=2.0 if large else 1.0)
 
@@ -85,7 +133,23 @@ def default_config(env: str) -> AgentConfig:
 def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
     """The room, with the start pose chosen by the seed: every seed starts somewhere else, as in
     the paper's protocol (the layout's start poses first, then poses sampled from the free
-    space; :func:`cogmap.starts.seed_start`)."""
+    space; :func:`cogmap.starts.seed_start`).
+
+    Parameters
+    ----------
+    env : str
+        The environment, as for :func:`layout_name`.
+    cfg : AgentConfig
+        Sets the step length (the influence radius) and the obstacle margin of the simulator.
+    seed : int
+        Start pose and noise seed.
+    noise : OdometryNoise, optional
+        Odometry drift; default none.
+
+    Returns
+    -------
+    NavSim
+        The simulator (the caller closes it)."""
     from cogmap.envs import NavSim, OdometryNoise, SimConfig
 
     from .starts import seed_start
@@ -100,12 +164,52 @@ def run_agent(sim, agent: AIMAPPAgent, steps: int, progress: bool = True, episod
               on_step=None, stop=None, desc: str = "explore") -> Episode:
     """Drive ``agent`` in ``sim`` for ``steps`` decisions, tracking LiDAR coverage (the
     harness's :func:`cogmap.harness.run_episode`; ``on_step`` and ``stop`` get the agent's
-    :class:`Decision`)."""
+    :class:`Decision`).
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+    agent : AIMAPPAgent
+        The agent.
+    steps : int
+        Largest number of decisions.
+    progress : bool, optional
+        Show a progress bar, default True.
+    episode : Episode, optional
+        An earlier episode to continue.
+    on_step, stop : callable, optional
+        Called with each decision (``stop`` returns whether to end).
+    desc : str, optional
+        Progress-bar label.
+
+    Returns
+    -------
+    Episode
+        The episode record.
+    """
     return run_episode(sim, AgentPolicy(agent), steps, progress=progress, episode=episode, on_step=on_step,
                        stop=stop, desc=desc)
 
 
 def episode_metrics(sim, ep: Episode) -> dict:
+    """The metrics of a run as ``metrics.json`` holds them.
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator the episode ran in (for the coverage tracker and the grid).
+    ep : Episode
+        The episode.
+
+    Returns
+    -------
+    dict
+        ``steps``, ``coverage`` (fraction), ``area_covered_m2``, ``free_area_m2``, ``distance_m``,
+        ``coverage_efficiency`` (m2/m), ``nauc``, ``num_states``, ``num_observations``,
+        ``decision_ms_mean`` / ``_p95``, ``rmse_belief_m`` / ``rmse_odometry_m`` (m, against the
+        true path) and ``failed_moves``.
+    """
     rows = ep.rows
     truth = np.array([[r["true_x"], r["true_y"]] for r in rows])
     odom = np.array([[r["odom_x"], r["odom_y"]] for r in rows])
@@ -133,6 +237,25 @@ def episode_metrics(sim, ep: Episode) -> dict:
 
 
 def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, title: str | None = None) -> None:
+    """Write a run directory: the model (``cogmap.genmodel.io``, no pickle), the place anchors, the
+    map as GraphML, the stored panoramas, ``trajectory.csv``, ``metrics.json`` and the map and
+    coverage plots.
+
+    Parameters
+    ----------
+    out : Path
+        The run directory (created if missing).
+    sim : NavSim
+        The simulator of the run (floor plan for the plots).
+    agent : AIMAPPAgent
+        The agent after the run.
+    ep : Episode
+        The episode.
+    metrics : dict
+        What :func:`episode_metrics` (and the end rule) returned.
+    title : str, optional
+        Title of the map plot.
+    """
     from cogmap.agent.correction import save_anchors
     from cogmap.genmodel.graph import write_graphml
     from cogmap.genmodel.io import save
@@ -179,6 +302,17 @@ class Done:
     to find a way. ``rule="seen-all"`` is the earlier rule (any decision without a reachable
     informative state counts toward ``SEEN_ALL``, and ``patience`` quiet decisions end it even while
     a target is pursued), kept to measure the change.
+
+    Parameters
+    ----------
+    agent : AIMAPPAgent
+        The exploring agent (read, never changed).
+    patience : int
+        Quiet decisions before the end (0: never end early).
+    rule : str, optional
+        ``"liveness"`` (default) or ``"seen-all"``.
+    loop_factor : int, optional
+        While a target is pursued the patience is ``loop_factor * patience``.
     """
 
     #: consecutive exploring decisions in which the agent's own sensed map shows nothing left to see
@@ -238,7 +372,13 @@ class Done:
     def summary(self) -> dict:
         """The end of exploration for ``metrics.json`` and the study rows: ``ended_by_agent``,
         ``end_reason`` and ``unvisited_reachable`` (states the agent predicts and believes reachable
-        but never visited, :func:`cogmap.agent.liveness.unvisited_reachable`)."""
+        but never visited, :func:`cogmap.agent.liveness.unvisited_reachable`).
+
+        Returns
+        -------
+        dict
+            ``{"ended_by_agent": bool, "end_reason": str, "unvisited_reachable": int}``.
+        """
         from cogmap.agent.liveness import unvisited_reachable
 
         return {"ended_by_agent": self.finished, "end_reason": self.reason,
@@ -252,7 +392,29 @@ SIM_STATE = ("pose", "odom", "rng", "step_count", "path", "odom_path", "schedule
 
 def save_state(out: Path, sim, agent: AIMAPPAgent, done: Done, ep: Episode, moved, distance: float) -> Path:
     """Checkpoint the exploration after a decision (:mod:`cogmap.checkpoint`: the model in its own
-    format, the rest as JSON + npz)."""
+    format, the rest as JSON + npz).
+
+    Parameters
+    ----------
+    out : Path
+        The run directory (the checkpoint goes to ``out/checkpoint``).
+    sim : NavSim
+        The simulator (its pose, odometry, generator and fault schedule are kept).
+    agent : AIMAPPAgent
+        The agent.
+    done : Done
+        The end rule and its counters.
+    ep : Episode
+        The episode so far.
+    moved : bool or None
+        Outcome of the last motion command.
+    distance : float
+        Distance travelled so far, metres.
+
+    Returns
+    -------
+    Path
+        The checkpoint directory."""
     from cogmap.checkpoint import save_checkpoint
 
     tracker = coverage_tracker(sim)
@@ -264,7 +426,23 @@ def save_state(out: Path, sim, agent: AIMAPPAgent, done: Done, ep: Episode, move
 
 def restore_state(path: Path, sim) -> tuple[AIMAPPAgent, Done, Episode, bool | None, float]:
     """Put ``sim`` (built afresh for the same layout and seed) back where the checkpoint left it and
-    return the agent, the end rule, the episode so far, the last motion outcome and the distance."""
+    return the agent, the end rule, the episode so far, the last motion outcome and the distance.
+
+    Parameters
+    ----------
+    path : Path
+        The checkpoint directory.
+    sim : NavSim
+        A simulator built afresh for the same layout and seed.
+
+    Returns
+    -------
+    agent : AIMAPPAgent
+    done : Done
+    episode : Episode
+    moved : bool or None
+    distance : float
+        Metres travelled so far."""
     from cogmap.checkpoint import load_checkpoint
 
     st = load_checkpoint(path)
@@ -287,6 +465,39 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
     decisions (removed once the run has finished and written its files). ``resume=True`` continues
     the run in ``out`` from its last checkpoint with the settings recorded in its ``run.json`` (the
     other arguments are ignored), or from the start when it stopped before its first checkpoint.
+
+    Parameters
+    ----------
+    env : str, optional
+        Layout name, registered id, ``building:KIND:SEED`` or layout file; default the mini warehouse.
+    steps : int, optional
+        Largest number of decisions, default 150.
+    seed : int, optional
+        Start pose, noise and agent seed.
+    out : Path or str, optional
+        Run directory to write; None writes nothing.
+    config : AgentConfig, optional
+        The agent's configuration; default :func:`default_config` of ``env``.
+    progress : bool, optional
+        Show a progress bar, default True.
+    noise : OdometryNoise, optional
+        Odometry drift, default none.
+    patience : int, optional
+        Quiet decisions before the agent ends its exploration (:class:`Done`), default 20.
+    checkpoint_every : int, optional
+        Decisions between checkpoints when ``out`` is given, default 10.
+    resume : bool, optional
+        Continue the run in ``out``.
+
+    Returns
+    -------
+    dict
+        The run's metrics (:func:`episode_metrics` plus the end of exploration).
+
+    Raises
+    ------
+    ValueError
+        When ``resume`` is asked without ``out``.
     """
     from cogmap.envs import OdometryNoise
 
