@@ -4,7 +4,7 @@ Dirichlet update, and how close the learned model comes to the true one.
 1. Time: square rooms of 16-400 places, 5 controls, a 10,000-step random walk, 5 iterations,
    B learned; microseconds per step of data and iteration, for one run and per restart of 4
    run together.
-2. Target (issue 11): a 5 x 5 room with 8 views (places share views), B learned with A given,
+2. Target: a 5 x 5 room with 8 views (places share views), B learned with A given,
    a 10,000-step random walk for training and a 2,000-step one held out; predictive surprise
    (bits per step) of the learned model against the true model's, for plain EM and for 4
    restarts with annealing, at two prior concentrations (F, a bound on -log evidence, ranks them).

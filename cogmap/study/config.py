@@ -132,7 +132,7 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
                                else ("aimapp", "frontier", "frontier_paper", "random"))
         plan["seeds"] = list(range(5 if full else 3))
         plan["steps"] = STEPS_FULL if full else STEPS_REDUCED
-    elif study == "generalisation":  # issue 15, item 5: layouts the agent was never tuned on
+    elif study == "generalisation":  # layouts the agent was never tuned on
         plan["envs"] = building_envs(GENERAL_BUILDINGS["full" if full else "reduced"])
         plan["methods"] = list(GENERAL_METHODS)
         plan["seeds"] = list(range(3 if full else 1))

@@ -255,7 +255,7 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
 
 
 # ---------------------------------------------------------------------------- generalisation
-#: issue 15's target over the procedural family: AIMAPP reaches the coverage level in at least this
+#: the target over the procedural family: AIMAPP reaches the coverage level in at least this
 #: fraction of runs, with a mean CE at that level at least this multiple of the oracle's
 GENERAL_TARGET = {"reached": 0.95, "ce_ratio": 0.9}
 

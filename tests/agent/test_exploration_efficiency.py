@@ -1,4 +1,4 @@
-"""Exploration efficiency in the pybullet house (issue 9): coverage efficiency at 90 % coverage.
+"""Exploration efficiency in the pybullet house: coverage efficiency at 90 % coverage.
 
 CE@90 = area covered / distance travelled, both read when LiDAR coverage first reaches 90 %
 (``bench/exploration.py`` computes it the same way over every layout and 5 seeds).

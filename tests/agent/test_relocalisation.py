@@ -1,4 +1,4 @@
-"""Issue 15: with perfect odometry no drift correction or relocalisation may move the believed
+"""With perfect odometry no drift correction or relocalisation may move the believed
 position by more than 1 m (seeded runs in procedural buildings, short budgets)."""
 
 import pytest

@@ -1,4 +1,4 @@
-"""The generalisation study (issue 15, item 5): its plan, its keys and one tiny run."""
+"""The generalisation study: its plan, its keys and one tiny run."""
 
 import json
 
