@@ -10,6 +10,8 @@ from collections.abc import Callable
 
 import gymnasium as gym
 
+from cogmap.genmodel.registry import check_entry, check_name
+
 from .layouts import LAYOUTS, Layout
 
 MAX_STEPS = 500
@@ -84,15 +86,9 @@ def register_layout(name: str, factory: Callable[..., Layout], *, env_id: str | 
     TypeError
         ``factory`` is not callable.
     """
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"register_layout: name must be a non-empty string, got {name!r}")
-    if not callable(factory):
-        raise TypeError(f"register_layout('{name}'): expected a callable factory(seed) -> Layout, "
-                        f"got {type(factory).__name__}")
-    if name in _BUILTIN_LAYOUTS:
-        raise ValueError(f"register_layout: '{name}' is a built-in layout; choose another name")
-    if name in LAYOUTS and not overwrite:
-        raise ValueError(f"register_layout: a layout named '{name}' exists (pass overwrite=True)")
+    check_name("register_layout", name)
+    check_entry("register_layout", "layout", name, factory, LAYOUTS, _BUILTIN_LAYOUTS, overwrite,
+                expected="a callable factory(seed) -> Layout", same_again=False)
     if env_id is not None:
         if not isinstance(env_id, str) or not env_id:
             raise ValueError(f"register_layout('{name}'): env_id must be a non-empty string, got {env_id!r}")

@@ -20,6 +20,7 @@ import numpy as np
 
 from cogmap.genmodel.dirichlet import novelty
 from cogmap.genmodel.numerics import LOG_FLOOR, xlogx
+from cogmap.genmodel.registry import check_entry, check_name
 
 EPS = LOG_FLOOR  # the shared log floor (cogmap.genmodel.numerics)
 
@@ -305,14 +306,11 @@ def register_term(name: str, term: Term, overwrite: bool = False, *, epistemic: 
     TypeError
         ``term`` is not callable.
     """
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"register_term: name must be a non-empty string, got {name!r}")
-    if not callable(term):
-        raise TypeError(f"register_term('{name}'): expected a callable term(ctx) -> (K,), got {type(term).__name__}")
+    check_name("register_term", name)
     if name in ALL_TERMS:
         raise ValueError(f"register_term: '{name}' is a built-in EFE term; choose another name")
-    if name in _USER_TERMS and not overwrite and _USER_TERMS[name] is not term:
-        raise ValueError(f"register_term: a term named '{name}' exists (pass overwrite=True)")
+    check_entry("register_term", "term", name, term, _USER_TERMS, ALL_TERMS, overwrite,
+                expected="a callable term(ctx) -> (K,)")
     _USER_TERMS[name] = term
     _USER_EPISTEMIC.pop(name, None)
     if epistemic:

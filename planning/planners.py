@@ -26,6 +26,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from cogmap.genmodel.registry import check_entry, check_name
+
 from .mcts import MCTSConfig
 
 
@@ -105,16 +107,10 @@ def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = 
     TypeError
         ``fn`` is not callable.
     """
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"register_planner: name must be a non-empty string, got {name!r}")
+    check_name("register_planner", name)
 
     def _add(f: Planner) -> Planner:
-        if not callable(f):
-            raise TypeError(f"register_planner('{name}'): expected a callable, got {type(f).__name__}")
-        if name in BUILTIN and _PLANNERS.get(name) is not f:
-            raise ValueError(f"register_planner: '{name}' is a built-in planner and cannot be replaced")
-        if name in _PLANNERS and not overwrite and _PLANNERS[name] is not f:
-            raise ValueError(f"register_planner: a planner named '{name}' exists (pass overwrite=True)")
+        check_entry("register_planner", "planner", name, f, _PLANNERS, BUILTIN, overwrite)
         _PLANNERS[name] = f
         return f
 

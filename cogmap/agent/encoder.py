@@ -21,6 +21,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
+from cogmap.genmodel.registry import check_entry, check_name
+
 C1 = (0.01 * 255) ** 2
 C2 = (0.03 * 255) ** 2
 BATCH = 128  # OpenCV 5 refuses GaussianBlur on more than 128 channels
@@ -511,18 +513,14 @@ def register_encoder(name: str, factory: Callable | None = None, *, overwrite: b
     TypeError
         ``factory`` is not callable, or is an encoder itself rather than a factory.
     """
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"register_encoder: name must be a non-empty string, got {name!r}")
+    check_name("register_encoder", name)
 
     def _add(f: Callable) -> Callable:
-        if not callable(f) or isinstance(f, Encoder):
-            got = (f"the encoder {type(f).__name__} itself (register lambda config: ... returning a new one)"
-                   if callable(f) else type(f).__name__)
-            raise TypeError(f"register_encoder('{name}'): expected a callable factory(config) -> Encoder, got {got}")
-        if name in _BUILTIN_ENCODERS and _ENCODERS.get(name) is not f:
-            raise ValueError(f"register_encoder: '{name}' is a built-in encoder; choose another name")
-        if name in _ENCODERS and not overwrite and _ENCODERS[name] is not f:
-            raise ValueError(f"register_encoder: an encoder named '{name}' exists (pass overwrite=True)")
+        if callable(f) and isinstance(f, Encoder):
+            raise TypeError(f"register_encoder('{name}'): expected a callable factory(config) -> Encoder, got the "
+                            f"encoder {type(f).__name__} itself (register lambda config: ... returning a new one)")
+        check_entry("register_encoder", "encoder", name, f, _ENCODERS, _BUILTIN_ENCODERS, overwrite,
+                    expected="a callable factory(config) -> Encoder")
         _ENCODERS[name] = f
         return f
 
