@@ -17,7 +17,28 @@ def _plt():
 
 
 def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> Path:
-    """Floor plan, true path (grey), believed nodes coloured by observation, edges by belief."""
+    """Floor plan, true path (grey), believed nodes coloured by observation, edges by belief.
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        PNG file to write.
+    sim : NavSim
+        The simulator after the run (its ``layout`` and true ``path``).
+    agent : AIMAPPAgent
+        The agent after the run; its states are drawn at ``agent.poses`` with edges of
+        transition probability >= 0.2 (line width grows with the probability), visited states
+        coloured by their most likely observation. Nothing is drawn if it has no model yet.
+    ep : Episode
+        The run's record (final coverage and distance go in the title).
+    title : str, optional
+        Figure title; by default the layout name, number of states, coverage and distance.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     from cogmap.envs.render import draw_layout
     from cogmap.genmodel.graph import to_graph
 
@@ -46,6 +67,22 @@ def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> 
 
 
 def coverage_curve(path: Path, ep, label: str = "AIMAPP") -> Path:
+    """LiDAR coverage (%) against distance travelled (m).
+
+    Parameters
+    ----------
+    path : pathlib.Path
+        PNG file to write.
+    ep : Episode
+        The run's record (``distance`` in metres and ``coverage`` in [0, 1], per step).
+    label : str
+        Legend label of the curve.
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(ep.distance, np.asarray(ep.coverage) * 100, lw=2, label=label)

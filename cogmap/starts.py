@@ -25,7 +25,29 @@ _MAX_TRIES = 2000
 
 def clear_start_cells(grid, robot_radius: float, margin: float, anchor_xy) -> np.ndarray:
     """Cells where a disc robot of ``robot_radius`` has ``margin`` clearance and that are
-    connected (8-neighbourhood) through such cells to ``anchor_xy``."""
+    connected (8-neighbourhood) through such cells to ``anchor_xy``.
+
+    Parameters
+    ----------
+    grid : OccupancyGrid
+        Ground-truth occupancy grid (provides ``clearance()`` in metres and ``world_to_cell``).
+    robot_radius : float
+        Robot radius in metres.
+    margin : float
+        Extra clearance in metres beyond the radius.
+    anchor_xy : sequence of float
+        World ``(x, y)`` in metres of a point in the wanted connected part (the layout's first start).
+
+    Returns
+    -------
+    numpy.ndarray of bool, shape (rows, cols)
+        True for the clear cells in the anchor's connected component.
+
+    Raises
+    ------
+    ValueError
+        If the anchor itself does not have ``robot_radius + margin`` clearance.
+    """
     clear = grid.clearance() >= robot_radius + margin
     labels, _ = ndimage.label(clear, structure=np.ones((3, 3)))
     r, c = grid.world_to_cell(anchor_xy)
@@ -37,7 +59,34 @@ def clear_start_cells(grid, robot_radius: float, margin: float, anchor_xy) -> np
 
 def seed_start(layout, seed: int, robot_radius: float, grid=None, margin: float = START_MARGIN_M,
                separation: float = START_SEPARATION_M) -> tuple[float, float, float]:
-    """The start pose (x, y, yaw) of ``seed`` in ``layout`` (see the module docstring)."""
+    """The start pose (x, y, yaw) of ``seed`` in ``layout`` (see the module docstring).
+
+    Parameters
+    ----------
+    layout : Layout
+        The room; ``layout.starts`` are its hand-chosen start poses.
+    seed : int
+        Seed index, ``>= 0``.
+    robot_radius : float
+        Robot radius in metres.
+    grid : OccupancyGrid, optional
+        Ground-truth grid of ``layout``; built with ``layout_grid`` if omitted.
+    margin : float
+        Clearance in metres beyond the radius (default :data:`START_MARGIN_M`).
+    separation : float
+        Minimum distance in metres from the starts of lower seeds (default :data:`START_SEPARATION_M`).
+
+    Returns
+    -------
+    tuple of float
+        ``(x, y, yaw)``: position in metres, yaw in radians in [-pi, pi).
+
+    Raises
+    ------
+    ValueError
+        If ``seed < 0``, or no clear cell is ``separation`` away from the earlier starts after
+        2000 draws.
+    """
     if seed < 0:
         raise ValueError("seed must be >= 0")
     starts = [tuple(float(v) for v in s) for s in layout.starts]

@@ -46,7 +46,38 @@ class ExploreConfig:
     ``penalty_from``: end points of the obstacle histogram from the scans ``"predicted"`` by the map mean
     at the estimated poses (Algorithm 2, line 6) or from the ``"observed"`` scans at the estimated poses
     (default: early in a run the learnt map predicts walls poorly and the agent ran into them);
-    ``curve_every``: spacing of the recorded curves."""
+    ``curve_every``: spacing of the recorded curves.
+
+    Attributes
+    ----------
+    method : str
+        ``"mi"``, ``"random"`` or ``"frontier"``.
+    mi : MIConfig
+        Planning settings of the ``mi`` agent (Algorithms 1-2, Appendix E).
+    replan_every : int
+        Steps executed per plan, a positive multiple of ``train_every``.
+    train_every : int
+        Steps per filtered chunk of the online SLAM.
+    train_iters : int
+        ELBO steps after each chunk.
+    learn_map : bool
+        Run the online SLAM for the baselines too.
+    penalty_from : str
+        ``"observed"`` or ``"predicted"`` scans for the obstacle histogram.
+    max_turn : float
+        Largest turn per step, in radians.
+    max_step : float
+        Largest forward step, in maze units.
+    curve_every : int
+        Steps between two points of the ratio curve (the information gain every ten times that).
+    seed : int
+        Seed of the start pose, the actuation noise and the agent.
+
+    Raises
+    ------
+    ValueError
+        For an unknown ``method`` or a ``replan_every`` that is not a positive multiple of ``train_every``.
+    """
 
     method: str = "mi"
     mi: MIConfig = field(default_factory=MIConfig)
@@ -68,6 +99,13 @@ class ExploreConfig:
                              f"train_every ({self.train_every})")
 
     def to_json(self) -> dict:
+        """The settings as a JSON-ready dict (``mi`` nested as a dict).
+
+        Returns
+        -------
+        dict
+            Field name -> value.
+        """
         return asdict(self)
 
 
@@ -78,6 +116,34 @@ STUDY_MI = MIConfig(horizon=50, n_candidates=6, n_marginal=24, n_maps=6, n_per_m
 
 @dataclass
 class ExploreResult:
+    """One exploration run (what :func:`explore` returns). Lengths are in maze units, angles in radians.
+
+    Attributes
+    ----------
+    poses : numpy.ndarray, shape (T, 3)
+        True poses (x, y, heading).
+    controls : numpy.ndarray, shape (T - 1, 2)
+        Commanded controls (turn, forward).
+    scans : numpy.ndarray, shape (T, n_beams)
+        LiDAR ranges per step.
+    estimates : numpy.ndarray, shape (T, 3), or None
+        The online SLAM's pose estimates (``mi`` or ``learn_map``), else None.
+    ratio_curve : list of (int, float)
+        ``(step, exploration ratio)`` over the Table II tiles.
+    info_curve : list of (int, float)
+        ``(step, KL(q(M) || p(M)))`` in nats (Appendix D); empty without a map.
+    plan_seconds : list of float
+        Wall-clock seconds of each planning call.
+    blocked : int
+        Steps on which a wall stopped the robot.
+    params : DVBFParams or None
+        q(M) and emission at the end (``mi`` or ``learn_map``).
+    model : DVBFConfig or None
+        The model of ``params``.
+    seconds : float
+        Wall-clock seconds of the whole run.
+    """
+
     poses: np.ndarray  # (T, 3) true poses
     controls: np.ndarray  # (T - 1, 2) commanded
     scans: np.ndarray  # (T, n_beams)
@@ -92,7 +158,20 @@ class ExploreResult:
 
 
 def start_pose(maze: Maze, seed: int) -> np.ndarray:
-    """A seeded start: the centre of a random cell, a random heading (the same for every method)."""
+    """A seeded start: the centre of a random cell, a random heading (the same for every method).
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze.
+    seed : int
+        Seed of the draw.
+
+    Returns
+    -------
+    numpy.ndarray, shape (3,)
+        ``(x, y, heading)``: a cell centre in maze units, heading in radians in [-pi, pi).
+    """
     rng = np.random.default_rng([seed, 17])
     c = (int(rng.integers(maze.n)), int(rng.integers(maze.n)))
     return np.array([*maze.cell_centre(*c), float(rng.uniform(-np.pi, np.pi))])
@@ -101,17 +180,63 @@ def start_pose(maze: Maze, seed: int) -> np.ndarray:
 # -- baselines -----------------------------------------------------------------------------------
 
 class RandomWalk:
+    """The ``random`` baseline: a uniform turn in ``[-max_turn, max_turn]`` and a full step each time
+    step; after a wall stopped it, a uniform turn in ``[-pi, pi]``.
+
+    Parameters
+    ----------
+    cfg : ExploreConfig
+        Supplies ``max_turn`` (rad) and ``max_step`` (maze units).
+    seed : int
+        Seed of the walk.
+    """
+
     def __init__(self, cfg: ExploreConfig, seed: int):
         self.cfg, self.rng, self.bounce = cfg, np.random.default_rng([seed, 1]), False
 
     def act(self, pose, scan, blocked: bool) -> np.ndarray:
+        """The next control.
+
+        Parameters
+        ----------
+        pose : numpy.ndarray, shape (3,)
+            Current pose (unused).
+        scan : numpy.ndarray, shape (n_beams,)
+            Current scan (unused).
+        blocked : bool
+            Whether a wall stopped the last step.
+
+        Returns
+        -------
+        numpy.ndarray, shape (2,)
+            ``(turn in rad, forward = max_step)``.
+        """
         if blocked:
             return np.array([self.rng.uniform(-np.pi, np.pi), self.cfg.max_step])
         return np.array([self.rng.uniform(-self.cfg.max_turn, self.cfg.max_turn), self.cfg.max_step])
 
 
 class Frontier:
-    """Nearest-frontier exploration on an occupancy grid from the true LiDAR returns at the true poses."""
+    """Nearest-frontier exploration on an occupancy grid from the true LiDAR returns at the true poses.
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze; the grid's cells are a quarter of its cell side.
+    cfg : ExploreConfig
+        Supplies ``max_turn``, ``max_step`` and ``replan_every``.
+    seed : int
+        Seed of the random walk used when no frontier is left.
+    lidar_range : float
+        LiDAR range in maze units (a return at range is not a wall).
+
+    Attributes
+    ----------
+    grid : numpy.ndarray of int8, shape (side, side)
+        0 unknown, 1 free, 2 occupied; indexed by ``floor(xy / res)``.
+    path : list of numpy.ndarray
+        Remaining waypoints (cell centres) to the chosen frontier.
+    """
 
     def __init__(self, maze: Maze, cfg: ExploreConfig, seed: int, lidar_range: float):
         self.cfg, self.maze = cfg, maze
@@ -127,6 +252,15 @@ class Frontier:
         return np.clip(np.floor(np.asarray(xy) / self.res).astype(int), 0, self.side - 1)
 
     def update(self, pose, scan) -> None:
+        """Mark the cells along each beam free (unless already occupied) and its end occupied.
+
+        Parameters
+        ----------
+        pose : numpy.ndarray, shape (3,)
+            True pose (x, y, heading); beam ``k`` points at ``heading + 2 pi k / n_beams``.
+        scan : numpy.ndarray, shape (n_beams,)
+            True ranges in maze units.
+        """
         n = len(scan)
         ang = pose[2] + 2 * np.pi * np.arange(n) / n
         d = np.stack([np.cos(ang), np.sin(ang)], 1)
@@ -160,6 +294,26 @@ class Frontier:
         return []
 
     def act(self, pose, scan, blocked: bool) -> np.ndarray:
+        """Update the grid and steer along the shortest 4-connected path to the nearest frontier.
+
+        Re-plans when blocked, when the path is used up or every ``replan_every`` steps; turns
+        towards the next waypoint (at most ``max_turn``) and moves only if the remaining heading
+        error is below 0.5 rad; with no frontier left, acts as :class:`RandomWalk`.
+
+        Parameters
+        ----------
+        pose : numpy.ndarray, shape (3,)
+            True pose (x, y, heading).
+        scan : numpy.ndarray, shape (n_beams,)
+            True ranges.
+        blocked : bool
+            Whether a wall stopped the last step.
+
+        Returns
+        -------
+        numpy.ndarray, shape (2,)
+            ``(turn in rad, forward in maze units)``.
+        """
         self.update(pose, scan)
         self.since += 1
         if blocked or not self.path or self.since >= self.cfg.replan_every:
@@ -194,7 +348,27 @@ def _scan_predictor(model):
 
 
 class MIPlanner:
-    """One planning call of the DVBF-LM agent on the current SLAM state (Algorithms 1-2)."""
+    """One planning call of the DVBF-LM agent on the current SLAM state (Algorithms 1-2).
+
+    Parameters
+    ----------
+    model : DVBFConfig
+        The SLAM's model (map extent, LiDAR range, transition noise).
+    mi : MIConfig
+        Candidate generation and scoring settings (Appendix E).
+    extent : float
+        Maze side in maze units.
+    seed : int
+        Seed of the planner's random keys.
+    penalty_from : str
+        ``"predicted"`` (map-mean scans, Algorithm 2 line 6) or ``"observed"`` scans for the
+        obstacle histogram.
+
+    Raises
+    ------
+    ValueError
+        For any other ``penalty_from``.
+    """
 
     def __init__(self, model, mi: MIConfig, extent: float, seed: int, penalty_from: str = "predicted"):
         import jax
@@ -209,6 +383,28 @@ class MIPlanner:
         self._predicted = _scan_predictor(model)
 
     def plan(self, slam, rng: np.random.Generator) -> tuple[np.ndarray, dict]:
+        """Best candidate control sequence by the mutual information ``I(x_1:T; M)`` (Section VI).
+
+        The obstacle penalty grid is built from 400 poses drawn among the SLAM's estimates so far;
+        candidates start from the current particles, are truncated at their predicted collision and
+        scored by :func:`cogmap.planning.mi_exploration.score_candidates`.
+
+        Parameters
+        ----------
+        slam : OnlineSLAM
+            Current filter and map state (read only).
+        rng : numpy.random.Generator
+            Draws the poses of the obstacle histogram.
+
+        Returns
+        -------
+        controls : numpy.ndarray, shape (horizon, 2)
+            The best sequence (turn rad, forward maze units), forward set to 0 from its predicted collision on.
+        info : dict
+            ``scores``, ``best`` (index), ``penalty``, ``grid`` (obstacle penalty), ``controls`` (all
+            candidates), ``free_steps`` (steps before each candidate's predicted collision), ``starts``
+            (the particles).
+        """
         import jax
         import jax.numpy as jnp
 
@@ -241,7 +437,13 @@ class MIPlanner:
 
 
 def cache_dir():
-    """Where the pretrained emission is kept between runs (``$XDG_CACHE_HOME/cogmap``, else ``~/.cache/cogmap``)."""
+    """Where the pretrained emission is kept between runs (``$XDG_CACHE_HOME/cogmap``, else ``~/.cache/cogmap``).
+
+    Returns
+    -------
+    pathlib.Path
+        The directory (not created here).
+    """
     import os
     from pathlib import Path
 
@@ -251,7 +453,24 @@ def cache_dir():
 def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters: int = 1500):
     """The emission network trained with known poses on a traversal of maze 0 (moderate / medium), as
     ``cogmap dvbf slam`` does; cached in ``cache_dir`` (npz + JSON) when given, since every run of a
-    study uses the same one."""
+    study uses the same one.
+
+    Parameters
+    ----------
+    cache_dir : path, optional
+        Cache directory; the network is stored under ``emission-maze0-s{seed}-{steps}-{iters}``.
+    seed : int
+        Seed of the traversal (``seed + 1000``) and of the training.
+    steps : int
+        Length of the traversal.
+    iters : int
+        ELBO steps of the training.
+
+    Returns
+    -------
+    emission
+        The trained emission network (from the cache if present).
+    """
     from pathlib import Path
 
     from cogmap.envs.maze import make_maze
@@ -288,7 +507,31 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
 
 
 def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=None) -> ExploreResult:
-    """Run one exploration of ``steps`` time steps (the start pose counts as step 0)."""
+    """Run one exploration of ``steps`` time steps (the start pose counts as step 0).
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze to explore.
+    steps : int
+        Time steps, ``>= 2``.
+    cfg : ExploreConfig
+        Method and settings.
+    emission : optional
+        A pretrained emission network, kept frozen in the online SLAM; None learns it online.
+    progress : callable, optional
+        Called with the step index after each step.
+
+    Returns
+    -------
+    ExploreResult
+        Poses, controls, scans, estimates, curves and timings.
+
+    Raises
+    ------
+    ValueError
+        If ``steps < 2``.
+    """
     import dataclasses
 
     if steps < 2:
@@ -373,7 +616,20 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
 
 
 def ratio_at(curve, step: int) -> float:
-    """The exploration ratio of a ``[(step, ratio)]`` curve at ``step`` (the last point at or before it)."""
+    """The exploration ratio of a ``[(step, ratio)]`` curve at ``step`` (the last point at or before it).
+
+    Parameters
+    ----------
+    curve : iterable of (int, float)
+        ``(step, ratio)`` pairs in increasing step order.
+    step : int
+        The step to read.
+
+    Returns
+    -------
+    float
+        The ratio, 0.0 if no point is at or before ``step``.
+    """
     best = 0.0
     for s, r in curve:
         if s <= step:

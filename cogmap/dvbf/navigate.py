@@ -32,7 +32,27 @@ GRID = 5  # 5 x 5 poses per maze
 
 def grid_poses(maze: Maze, k: int = GRID, seed: int = 0) -> np.ndarray:
     """``k * k`` free poses ``(x, y, heading)``: the points of a ``k x k`` grid over the maze, each moved
-    to the centre of the maze cell it falls in (so none lies on a wall), with seeded headings."""
+    to the centre of the maze cell it falls in (so none lies on a wall), with seeded headings.
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze.
+    k : int
+        Poses per side (default :data:`GRID`).
+    seed : int
+        Seed of the headings (combined with the maze's seed).
+
+    Returns
+    -------
+    numpy.ndarray, shape (k * k, 3)
+        ``(x, y, heading)``: cell centres in maze units, headings in radians in [-pi, pi).
+
+    Raises
+    ------
+    ValueError
+        If two grid points fall in the same maze cell.
+    """
     rng = np.random.default_rng([seed, maze.seed])
     pts = (np.arange(k) + 0.5) / k * maze.size
     out = []
@@ -47,7 +67,27 @@ def grid_poses(maze: Maze, k: int = GRID, seed: int = 0) -> np.ndarray:
 
 
 def pose_pairs(n_poses: int, pairs: int | None = None, seed: int = 0) -> list[tuple[int, int]]:
-    """All ordered pairs ``(i, j), i != j`` of ``n_poses`` poses, or a seeded subset of ``pairs`` of them."""
+    """All ordered pairs ``(i, j), i != j`` of ``n_poses`` poses, or a seeded subset of ``pairs`` of them.
+
+    Parameters
+    ----------
+    n_poses : int
+        Number of poses.
+    pairs : int, optional
+        Pairs wanted; None (or at least ``n_poses * (n_poses - 1)``) gives all of them.
+    seed : int
+        Seed of the subset.
+
+    Returns
+    -------
+    list of (int, int)
+        ``(start index, goal index)`` in lexicographic order.
+
+    Raises
+    ------
+    ValueError
+        If ``pairs < 1``.
+    """
     every = [(i, j) for i in range(n_poses) for j in range(n_poses) if i != j]
     if pairs is None or pairs >= len(every):
         return every
@@ -67,7 +107,23 @@ def learned_scan_fn(params, cfg, k_std: float = STD_K):
     the map mean alone. With ``k_std > 0`` parts of the map the traversal never saw (q(M) still at the
     prior) read as close, so the safety term keeps plans out of them; at the mean they can read as open
     (maze 2: 4 of 30 plans at the mean crossed an unseen wall, none with ``k_std = 1``).
-    Batches are padded to powers of two so few shapes are ever compiled."""
+    Batches are padded to powers of two so few shapes are ever compiled.
+
+    Parameters
+    ----------
+    params : DVBFParams
+        The learned q(M) and emission network.
+    cfg : DVBFConfig
+        Their model (extent, beams, chart radii).
+    k_std : float
+        Standard deviations subtracted from the predicted ranges (default :data:`STD_K`).
+
+    Returns
+    -------
+    callable
+        ``scan(poses)``: poses ``(K, 3)`` (or one ``(3,)``) to ranges ``numpy.ndarray (K, n_beams)``
+        in maze units.
+    """
     import equinox as eqx
     import jax
     import jax.numpy as jnp
@@ -113,7 +169,42 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     dvbf slam`` (25 x 25, emission pretrained on maze 0 and frozen, std 0.1, 1,500 Adam steps) 5 plans
     hit a wall at blurred wall ends; with these defaults none did. Which change matters most was not
     separated.
-    Returns ``(params, cfg, info)``."""
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze to map.
+    steps : int
+        Length of the seeded traversal.
+    iters : int
+        Adam steps on the ELBO (Eq. 3).
+    seed : int
+        Seed of the traversal (the fit uses ``seed + 1``).
+    pretrain_maze : int, optional
+        Maze (same family) on which to pretrain and then freeze the emission.
+    pretrain_steps, pretrain_iters : int
+        Traversal length and Adam steps of that pretraining.
+    hidden : int
+        Hidden units of the emission network.
+    map_side : int, optional
+        Map grid cells per side; default twice the Table II side.
+    sigma_e : float
+        Emission std used in training, in maze units.
+
+    Returns
+    -------
+    params : DVBFParams
+        The fitted q(M) and emission.
+    cfg : DVBFConfig
+        The model.
+    info : dict
+        How it was learnt (steps, iterations, map side, ``final_negative_elbo``, ``train_s`` seconds).
+
+    Raises
+    ------
+    ValueError
+        If ``pretrain_maze`` is ``maze`` itself.
+    """
     from cogmap.envs.maze_traversal import traverse
     from cogmap.genmodel.dvbf import DVBFConfig
 
@@ -141,7 +232,24 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
 
 
 def execute(sim, start, controls) -> tuple[np.ndarray, int]:
-    """Run ``controls`` open loop from ``start`` in ``sim``; returns executed poses and blocked moves."""
+    """Run ``controls`` open loop from ``start`` in ``sim``; returns executed poses and blocked moves.
+
+    Parameters
+    ----------
+    sim : MazeSim
+        The simulator (reset to ``start``).
+    start : array_like, shape (3,)
+        Start pose (x, y, heading).
+    controls : array_like, shape (n, 2)
+        Controls (turn rad, forward maze units).
+
+    Returns
+    -------
+    poses : numpy.ndarray, shape (n + 1, 3)
+        The start and the pose after each control.
+    blocked : int
+        Controls during which a wall stopped the robot.
+    """
     poses = [sim.reset(start)]
     blocked = 0
     for u in np.asarray(controls, float).reshape(-1, 2):
@@ -167,7 +275,32 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
                    progress=None) -> tuple[list[dict], dict]:
     """Plan every pair with every scan function (``{"learned": fn, "true": fn}``) and execute each plan
     in a noise-free simulator. Returns per-plan rows and ``{"paths": {model: [(pair, Plan, executed,
-    goal)]}, "grid_s": {model: seconds to scan the heuristic's grid}}``."""
+    goal)]}, "grid_s": {model: seconds to scan the heuristic's grid}}``.
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze.
+    scan_fns : dict of str to callable
+        Model name -> ``scan(poses (K, 3)) -> ranges (K, n_beams)`` (see :func:`scan_models`).
+    poses : numpy.ndarray, shape (n_poses, 3)
+        Candidate start and goal poses.
+    pairs : iterable of (int, int)
+        ``(start index, goal index)``.
+    config : HybridAStarConfig
+        Planner settings.
+    progress : callable, optional
+        Called with the number of pairs done.
+
+    Returns
+    -------
+    rows : list of dict
+        One per (pair, model): ``found``, ``success`` (final position within
+        :data:`SUCCESS_RADIUS` of the goal, Section V-B), ``final_error`` and lengths in maze units,
+        ``heading_error`` in radians, ``blocked_moves``, planner counts and ``plan_s`` seconds.
+    extra : dict
+        ``paths`` and ``grid_s`` as above.
+    """
     from cogmap.envs.maze_sim import MazeSim
 
     rows, paths = [], {name: [] for name in scan_fns}
@@ -192,7 +325,21 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
 
 def summarise(rows: list[dict]) -> dict:
     """Success rate per model, path length ratio of each learned model to the true simulator over pairs
-    both found (``length_ratio`` for ``learned``, ``length_ratio_<name>`` for others), plan times."""
+    both found (``length_ratio`` for ``learned``, ``length_ratio_<name>`` for others), plan times.
+
+    Parameters
+    ----------
+    rows : list of dict
+        The rows of :func:`navigate_pairs`.
+
+    Returns
+    -------
+    dict
+        Per model: ``pairs``, ``found``, ``success``, ``success_rate``, ``collided`` (plans with a
+        blocked move), median and mean ``plan_s`` (seconds), median expansions; and for each model
+        other than ``true`` the ``pairs``, ``mean``, ``median`` and ``max`` of its plan length over
+        the true simulator's (None when no pair qualifies).
+    """
     out = {}
     models = sorted({r["model"] for r in rows})
     for m in models:
@@ -221,7 +368,24 @@ def summarise(rows: list[dict]) -> dict:
 def scan_models(params, cfg, sim, k_std: float = STD_K) -> dict:
     """The three worlds each pair is planned in: ``learned`` (q(M), ranges lowered by ``k_std``
     standard deviations), ``learned_mean`` (the prediction at the map mean, the paper's reading) and
-    ``true`` (the simulator's ray casts, the reference row)."""
+    ``true`` (the simulator's ray casts, the reference row).
+
+    Parameters
+    ----------
+    params : DVBFParams
+        The learned q(M) and emission.
+    cfg : DVBFConfig
+        Their model.
+    sim : MazeSim
+        The true simulator (its ``lidar_batch``).
+    k_std : float
+        Standard deviations for ``learned`` (default :data:`STD_K`).
+
+    Returns
+    -------
+    dict of str to callable
+        ``{"learned", "learned_mean", "true"}`` -> ``scan(poses (K, 3)) -> ranges (K, n_beams)``.
+    """
     return {"learned": learned_scan_fn(params, cfg, k_std), "learned_mean": learned_scan_fn(params, cfg, 0.0),
             "true": sim.lidar_batch}
 
@@ -235,7 +399,49 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     pose pairs (None: all ordered pairs; 600 for the 5 x 5 grid) in the learned model and in the true
     simulator, and write the run directory to ``out`` (if given). ``model``: an already learnt
     ``(params, cfg, info)``; ``grid``: poses per side (at most the maze's cells per side). Returns
-    the metrics."""
+    the metrics.
+
+    Parameters
+    ----------
+    maze_seed : int
+        Seed of the maze.
+    out : pathlib.Path, optional
+        Run directory (``run.json``, ``model.npz``/``model.json``, ``poses.csv``, ``pairs.csv``,
+        ``metrics.json``, ``paths.png``); nothing is written if None.
+    pairs : int, optional
+        Seeded pairs to plan; None for all ordered pairs.
+    seed : int
+        Seed of the poses' headings, the pairs and the learnt model.
+    complexity, corridor : str
+        Maze family (Table II).
+    model_dir : pathlib.Path, optional
+        A run directory to load the model from (:func:`~cogmap.dvbf.run.load_params`).
+    map_steps, map_iters : int
+        Traversal length and Adam steps of :func:`learn_model`.
+    pretrain_maze : int, optional
+        Maze to pretrain the emission on (see :func:`learn_model`).
+    pretrain_iters : int
+        Adam steps of that pretraining.
+    config : HybridAStarConfig, optional
+        Planner settings; default ``HybridAStarConfig()``.
+    progress : bool
+        Show a progress bar.
+    model : tuple, optional
+        An already learnt ``(params, cfg, info)``; takes precedence over ``model_dir``.
+    grid : int
+        Poses per side.
+
+    Returns
+    -------
+    dict
+        The maze, seed, number of pairs, :data:`SUCCESS_RADIUS`, the model's ``info``, ``grid_s``
+        and the entries of :func:`summarise`.
+
+    Raises
+    ------
+    ValueError
+        If the model's extent differs from the maze's side, or from :func:`grid_poses`.
+    """
     from cogmap.envs.maze_sim import MazeSim
 
     config = config or HybridAStarConfig()
@@ -300,7 +506,20 @@ def _write_run(out: Path, maze, params, cfg, poses, rows, paths, metrics, config
 
 def save_paths_png(maze: Maze, paths: dict, filename, n: int = 4) -> None:
     """Planned (dashed) and executed (solid) paths of the first ``n`` pairs, learned model beside the
-    true simulator (paper Figure 6a-b)."""
+    true simulator (paper Figure 6a-b).
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze drawn underneath.
+    paths : dict
+        Model name -> ``[(pair, Plan, executed (n, 3), goal (3,))]`` (``extra["paths"]`` of
+        :func:`navigate_pairs`); only ``learned`` and ``true`` are drawn.
+    filename : path
+        PNG file to write.
+    n : int
+        Pairs drawn per panel.
+    """
     import matplotlib
 
     matplotlib.use("Agg", force=False)

@@ -26,7 +26,17 @@ NOISE = ActuationNoise(rot_std=0.005, trans_frac=0.05)
 
 
 def save_params(params, cfg: DVBFConfig, out: Path) -> None:
-    """``model.npz`` (every array leaf, by its pytree path) and ``model.json`` (config and leaf names)."""
+    """``model.npz`` (every array leaf, by its pytree path) and ``model.json`` (config and leaf names).
+
+    Parameters
+    ----------
+    params : DVBFParams
+        q(M) and the emission network.
+    cfg : DVBFConfig
+        The model they belong to (written to ``model.json`` so :func:`load_params` can rebuild them).
+    out : pathlib.Path
+        Existing directory to write the two files into.
+    """
     import equinox as eqx
     import jax
 
@@ -38,7 +48,30 @@ def save_params(params, cfg: DVBFConfig, out: Path) -> None:
 
 
 def load_params(out: Path):
-    """Rebuild the parameters written by :func:`save_params`; returns ``(params, cfg)``."""
+    """Rebuild the parameters written by :func:`save_params`.
+
+    The structure comes from a fresh ``init_params(cfg, ...)``; every array leaf is then replaced
+    by the stored array of the same pytree path.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        Directory holding ``model.npz`` and ``model.json``.
+
+    Returns
+    -------
+    params : DVBFParams
+        The stored q(M) and emission network.
+    cfg : DVBFConfig
+        The stored model configuration.
+
+    Raises
+    ------
+    FileNotFoundError
+        If either file is missing.
+    KeyError
+        If ``model.npz`` lacks an array the configuration needs.
+    """
     import equinox as eqx
     import jax
 
@@ -65,6 +98,41 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     With ``pretrain_maze`` (default 0), the emission network is first trained with known poses on a
     ``pretrain_steps`` traversal of that maze and then frozen; online SLAM learns only q(M).
     ``overrides`` replace :class:`SLAMConfig` fields (for example ``train_iters``); returns the metrics.
+
+    Parameters
+    ----------
+    maze_seed : int
+        Seed of the evaluation maze.
+    steps : int
+        Time steps of the traversal (the start counts as step 0).
+    out : pathlib.Path
+        Run directory (created if missing).
+    seed : int
+        Seed of the traversal, the filter and the training.
+    progress : bool
+        Show a progress bar.
+    complexity, corridor : str
+        Maze family (Table II).
+    pretrain_maze : int or None
+        Maze seed whose traversal pretrains the emission (Section IV); None learns it online.
+    pretrain_steps : int
+        Length of that pretraining traversal.
+    pretrain_iters : int
+        ELBO steps of the pretraining.
+    **overrides
+        :class:`SLAMConfig` fields.
+
+    Returns
+    -------
+    dict
+        The contents of ``metrics.json``: localisation errors (final and mean, of online SLAM and of
+        path integration, in maze units), true path length, run time in seconds, number of training
+        steps and the final negative ELBO.
+
+    Raises
+    ------
+    ValueError
+        If ``pretrain_maze == maze_seed``.
     """
     if pretrain_maze is not None and pretrain_maze == maze_seed:
         raise ValueError(f"slam_run: the emission is pretrained on maze {pretrain_maze}; evaluate on another maze")
@@ -159,6 +227,39 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     (exploration ratio at the budget, its curve, information gain, planning time), ``path.png`` (the paths on
     the maze) and ``ratio.png`` (exploration ratio and information gain against the steps).
     ``overrides`` replace :class:`~cogmap.dvbf.explore.ExploreConfig` fields.
+
+    Parameters
+    ----------
+    maze_seed : int
+        Seed of the maze (not 0: the emission is pretrained there).
+    out : pathlib.Path
+        Run directory (created if missing).
+    steps : int, optional
+        Time steps per method; default the maze's Table II step budget.
+    seed : int
+        Seed of the start pose, the actuation noise and the agents.
+    complexity, corridor : str
+        Maze family (Table II).
+    methods : sequence of str
+        Any of ``"mi"``, ``"random"``, ``"frontier"``.
+    cache_dir : path, optional
+        Where the pretrained emission is cached; default :func:`cogmap.dvbf.explore.cache_dir`.
+    progress : bool
+        Show a progress bar per method.
+    **overrides
+        :class:`~cogmap.dvbf.explore.ExploreConfig` fields (``mi`` defaults to
+        :data:`~cogmap.dvbf.explore.STUDY_MI`).
+
+    Returns
+    -------
+    dict
+        The contents of ``metrics.json``: the maze, budget and tiles, each method's
+        :func:`summarise`, and ``ratio_at_budget`` (method -> exploration ratio at the last step).
+
+    Raises
+    ------
+    ValueError
+        If ``maze_seed == 0``, or from :class:`~cogmap.dvbf.explore.ExploreConfig` for bad settings.
     """
     from cogmap.envs.maze_render import save_maze_png
     from cogmap.runs import write_manifest
@@ -213,7 +314,26 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
 
 
 def summarise(res, maze, steps: int) -> dict:
-    """Metrics of one :class:`~cogmap.dvbf.explore.ExploreResult`."""
+    """Metrics of one :class:`~cogmap.dvbf.explore.ExploreResult`.
+
+    Parameters
+    ----------
+    res : ExploreResult
+        One method's exploration.
+    maze : Maze
+        The maze it explored (unused; kept for a uniform call).
+    steps : int
+        Time steps of the run; the final ratio is read at step ``steps - 1``.
+
+    Returns
+    -------
+    dict
+        ``ratio_final`` and ``ratio_curve`` (exploration ratio, Appendix D), ``info_gain_curve`` and
+        ``info_gain_final`` (``KL(q(M) || p(M))`` in nats, None without a map), ``blocked_steps``,
+        ``path_length`` (maze units), ``run_s``, ``plan_calls``, ``plan_call_median_s`` and
+        ``plan_call_first_s`` (seconds, None without planning) and, with pose estimates,
+        ``localisation_error_final`` / ``localisation_error_mean`` (maze units).
+    """
     from .explore import ratio_at
 
     plan = np.array(res.plan_seconds) if res.plan_seconds else None

@@ -30,7 +30,39 @@ class SLAMConfig:
     uncertainty carried to first order (:func:`~cogmap.genmodel.dvbf.log_likelihood_marginal`) rather
     than at the map mean alone; ``recent``: share of each training batch drawn from the last
     ``recent_window`` steps, so the map where the agent is now is learnt before the filter leans on it;
-    ``freeze_emission``: keep the starting emission network fixed and learn only q(M)."""
+    ``freeze_emission``: keep the starting emission network fixed and learn only q(M).
+
+    Attributes
+    ----------
+    n_particles : int
+        Particles of the filter.
+    pf_sigma : float
+        Per-beam std (in the emission's range units) used to weight particles (Appendix B).
+    train_every : int
+        Steps filtered between two training rounds (the chunk length).
+    train_iters : int
+        Adam steps on the ELBO (Eq. 3) after each chunk.
+    batch : int
+        Time steps per ELBO batch.
+    cache : int
+        Resampled particles kept per step for training (asynchronous particles, III-D2).
+    learning_rate : float
+        Adam learning rate.
+    init_std : tuple of float
+        Std of the initial particles around the known start: (x m, y m, yaw rad).
+    model : DVBFConfig
+        The DVBF-LM model (map grid, emission, transition noise).
+    marginal : bool
+        Weight particles by the map-marginal likelihood instead of the map mean.
+    recent : float
+        Share in [0, 1] of each training batch drawn from the last ``recent_window`` steps.
+    recent_window : int
+        Length in steps of that recent window.
+    freeze_emission : bool
+        Keep the starting emission network fixed.
+    seed : int
+        Seed of the filter's and training's random numbers.
+    """
 
     n_particles: int = 20
     pf_sigma: float = 0.05
@@ -48,6 +80,13 @@ class SLAMConfig:
     seed: int = 0
 
     def to_json(self) -> dict:
+        """The settings as a JSON-ready dict (``model`` nested as a dict).
+
+        Returns
+        -------
+        dict
+            Field name -> value.
+        """
         d = asdict(self)
         d["model"] = asdict(self.model)
         return d
@@ -55,6 +94,24 @@ class SLAMConfig:
 
 @dataclass
 class SLAMResult:
+    """What :func:`online_slam` returns.
+
+    Attributes
+    ----------
+    estimates : numpy.ndarray, shape (T, 3)
+        Weighted particle mean per step: (x m, y m, yaw rad).
+    spreads : numpy.ndarray, shape (T, 3)
+        Weighted particle std per step, same units.
+    particles : numpy.ndarray, shape (n_particles, 3)
+        The filter's particles at the last step.
+    params : DVBFParams
+        q(M) and the emission network after the last training step.
+    losses : numpy.ndarray, shape (n_train_steps,)
+        Negative ELBO (Eq. 3) of each training step.
+    seconds : float
+        Wall-clock time of the run (not counting construction).
+    """
+
     estimates: np.ndarray  # (T, 3) weighted particle mean per step
     spreads: np.ndarray  # (T, 3) weighted particle std per step
     particles: np.ndarray  # (n_particles, 3) at the last step
@@ -64,7 +121,23 @@ class SLAMResult:
 
 
 def path_integration(start, controls) -> np.ndarray:
-    """Poses ``(T, 3)`` from dead reckoning with the engineered transition mean (no map)."""
+    """Poses ``(T, 3)`` from dead reckoning with the engineered transition mean (no map).
+
+    The control is applied as "turn, then drive": ``yaw += u[0]``, then move ``u[1]`` along the
+    new heading (``genmodel.dvbf.kinematic_mean``, the transition without its noise).
+
+    Parameters
+    ----------
+    start : array_like, shape (3,)
+        Initial pose (x m, y m, yaw rad).
+    controls : array_like, shape (T - 1, 2)
+        Per step (turn in rad, forward distance in m).
+
+    Returns
+    -------
+    numpy.ndarray, shape (T, 3)
+        ``start`` followed by the integrated poses, yaw wrapped to [-pi, pi).
+    """
     poses = [np.asarray(start, float)]
     for u in np.asarray(controls, float):
         x, y, a = poses[-1]
@@ -77,7 +150,34 @@ def fit_known_poses(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: int
                     learning_rate: float = 1e-2, seed: int = 0, emission=None):
     """q(M) and the emission network fit by the ELBO to a traversal with known poses (each time step's
     only particle is its true pose). With ``emission`` given, that network is kept fixed and only q(M)
-    is learnt. Returns ``(params, losses)``."""
+    is learnt.
+
+    Parameters
+    ----------
+    poses : array_like, shape (T, 3)
+        True pose per step (x m, y m, yaw rad).
+    scans : array_like, shape (T, n_beams)
+        Range scan per step.
+    cfg : DVBFConfig
+        The model.
+    iters : int
+        Adam steps on the ELBO (Eq. 3).
+    batch : int
+        Time steps per batch, drawn uniformly.
+    learning_rate : float
+        Adam learning rate.
+    seed : int
+        Seed of the initial parameters and the batches.
+    emission : optional
+        A fixed emission network; if given, only q(M) is learnt.
+
+    Returns
+    -------
+    params : DVBFParams
+        The fitted q(M) and emission.
+    losses : numpy.ndarray, shape (iters,)
+        Negative ELBO of each step.
+    """
     import jax
     import jax.numpy as jnp
 
@@ -104,7 +204,20 @@ def pretrain_emission(poses, scans, cfg: DVBFConfig, iters: int = 1500, batch: i
                       learning_rate: float = 1e-2, seed: int = 0):
     """Emission network trained (with a map of its own, then discarded) on a traversal with known
     poses, such as a first maze that is not used for evaluation (the paper pretrains its transition
-    this way, Section IV). Returns ``(emission, losses)``."""
+    this way, Section IV).
+
+    Parameters
+    ----------
+    poses, scans, cfg, iters, batch, learning_rate, seed
+        As in :func:`fit_known_poses`.
+
+    Returns
+    -------
+    emission
+        The trained emission network.
+    losses : numpy.ndarray, shape (iters,)
+        Negative ELBO of each step.
+    """
     params, losses = fit_known_poses(poses, scans, cfg, iters, batch, learning_rate, seed)
     return params.emission, losses
 
@@ -160,6 +273,30 @@ class OnlineSLAM:
     sizes the buffers). ``emission``: an emission network to start from (for example one trained on a
     first maze, as the paper pretrains its transition); by default a freshly initialised one. The map
     always starts at the prior; the initial pose ``start`` is known.
+
+    Parameters
+    ----------
+    start : array_like, shape (3,)
+        Known initial pose (x m, y m, yaw rad); particles start around it with ``config.init_std``.
+    config : SLAMConfig
+        Filter and training settings.
+    capacity : int
+        The most steps that will be seen, including the first.
+    emission : optional
+        Emission network to start from.
+    first_scan : array_like, shape (n_beams,), optional
+        The scan at ``start`` (step 0), used by training.
+
+    Attributes
+    ----------
+    params : DVBFParams
+        Current q(M) and emission.
+    estimates, spreads : numpy.ndarray, shape (capacity, 3)
+        Weighted particle mean and std per filtered step.
+    losses : list of float
+        Negative ELBO of each training step so far.
+    t : int
+        Index of the last filtered step.
     """
 
     def __init__(self, start, config: SLAMConfig, capacity: int, emission=None, first_scan=None):
@@ -200,6 +337,7 @@ class OnlineSLAM:
 
     @property
     def particles(self) -> np.ndarray:
+        """The filter's current particles, shape (n_particles, 3): (x m, y m, yaw rad)."""
         return np.asarray(self.state.particles)
 
     @property
@@ -210,7 +348,22 @@ class OnlineSLAM:
     def advance(self, controls, scans, flush: bool = False) -> None:
         """Queue steps (``controls (n, 2)`` leading to ``scans (n, n_beams)``); every full chunk of
         ``train_every`` steps is filtered and followed by ``train_iters`` ELBO steps. ``flush`` also
-        processes a last, shorter chunk."""
+        processes a last, shorter chunk.
+
+        Parameters
+        ----------
+        controls : array_like, shape (n, 2) or (2,)
+            Per step (turn rad, forward m).
+        scans : array_like, shape (n, n_beams) or (n_beams,)
+            The scan observed after each control.
+        flush : bool
+            Also filter and train on a last chunk shorter than ``train_every``.
+
+        Raises
+        ------
+        ValueError
+            If ``controls`` and ``scans`` differ in length, or the steps exceed ``capacity``.
+        """
         for u, x in zip(np.atleast_2d(controls), np.atleast_2d(scans), strict=True):
             self._pending_u.append(np.asarray(u, float))
             self._pending_x.append(np.asarray(x, float))
@@ -263,6 +416,31 @@ def online_slam(scans, controls, start, config: SLAMConfig, progress=None, emiss
     ``emission``: an emission network to start from (for example one trained on a first maze, as
     the paper pretrains its transition); by default a freshly initialised one. The map always starts
     at the prior.
+
+    Parameters
+    ----------
+    scans : array_like, shape (T, n_beams)
+        Range scan per step.
+    controls : array_like, shape (T - 1, 2)
+        Control (turn rad, forward m) leading from step ``t`` to ``t + 1``.
+    start : array_like, shape (3,)
+        Known initial pose (x m, y m, yaw rad).
+    config : SLAMConfig
+        Filter and training settings.
+    progress : callable, optional
+        Called with the number of steps filtered after each chunk.
+    emission : optional
+        Emission network to start from.
+
+    Returns
+    -------
+    SLAMResult
+        Per-step estimates and spreads, final particles and parameters, losses and run time.
+
+    Raises
+    ------
+    ValueError
+        If there are not exactly ``T - 1`` controls.
     """
     scans = np.asarray(scans, float)
     controls = np.asarray(controls, float)
