@@ -26,7 +26,7 @@ API = {
     "inference": ("cogmap.inference", "cogmap.inference", "inference"),
     "planning": ("cogmap.planning", "cogmap.planning", "planning"),
     "envs": ("cogmap.envs", "cogmap.envs", "envs"),
-    "agent": ("Agent loop, harness and AIMAPP", "cogmap", "cogmap"),
+    "agent": ("cogmap: agent loop, harness, runs, command line", "cogmap", "cogmap"),
     "aimapp": ("cogmap.agent (AIMAPP)", "cogmap.agent", "cogmap/agent"),
     "baselines": ("cogmap.baselines", "cogmap.baselines", "cogmap/baselines"),
     "drone": ("cogmap.drone", "cogmap.drone", "cogmap/drone"),
