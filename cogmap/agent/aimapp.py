@@ -426,7 +426,7 @@ class AIMAPPAgent:
     def _record_frame_move(self, kind: str, before, odometry) -> None:
         """Note in :attr:`frame_moves` how far the belief frame's change moved the believed position."""
         moved = float(np.hypot(*(self.believed_pose(odometry) - np.asarray(before)[:2])))
-        self.__dict__.setdefault("frame_moves", []).append({"step": self.step_count, "kind": kind, "moved_m": moved})
+        self.frame_moves.append({"step": self.step_count, "kind": kind, "moved_m": moved})
 
     # -- the cycle -------------------------------------------------------------------------
     def _paused(self, sensed: Sensed) -> Decision:
@@ -676,9 +676,8 @@ class AIMAPPAgent:
         if last is not None and self._outcome and state != last.state and last.action != cfg.stay:
             learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
                              reverse_control=self._reverse(last.action), rates=cfg.learning)
-            traversed = self.__dict__.setdefault("traversed", set())
-            traversed.add((int(last.state), int(last.action), state))
-            traversed.add((state, int(self._reverse(last.action)), int(last.state)))
+            self.traversed.add((int(last.state), int(last.action), state))
+            self.traversed.add((state, int(self._reverse(last.action)), int(last.state)))
         if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
             return 0
         return self._expand(state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan, pose)
@@ -716,7 +715,7 @@ class AIMAPPAgent:
         move = self.poses[target] - pose
         if not blocked(scan, move, cfg.robot_radius + cfg.obstacle_margin)[0]:
             return False
-        if state is not None and (int(state), int(heading), int(target)) in getattr(self, "traversed", ()):
+        if state is not None and (int(state), int(heading), int(target)) in self.traversed:
             return bool(blocked(scan, move, cfg.robot_radius)[0])
         return True
 
