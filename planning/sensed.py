@@ -247,10 +247,11 @@ def line_of_sight(grid: SensedGrid, a, b, grown: bool = False) -> np.ndarray:
 
 
 def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.ndarray, np.ndarray]:
-    """Breadth-first growth from ``sources_xy`` (m, 2) over sensed free cells that are not
-    :func:`opaque`, up to ``max_dist``: per cell, the index of the source reached first (-1:
-    none) and the path length (m, 4-connected steps; inf: not reached). Ties go to the lower
-    source index."""
+    """Growth from ``sources_xy`` (m, 2) over sensed free cells that are not :func:`opaque`, up to
+    ``max_dist``: per cell, the index of the source reached first (-1: none) and the path length
+    (m; inf: not reached). Paths are 8-connected (diagonal steps sqrt(2) cells long, never
+    cutting an impassable corner), so a length is at most 8 % above the straight line in open
+    space, whatever the direction. Ties go to the lower source index."""
     H, W = grid.cells.shape
     full_label = np.full((H, W), -1, dtype=np.int64)
     full_dist = np.full((H, W), np.inf)
@@ -267,16 +268,22 @@ def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.n
     src_idx = np.flatnonzero(ok)
     Hw, Ww = passable.shape
     passable[src[:, 0], src[:, 1]] = True  # a source is walkable even at the fringe of a wall
-    # 4-connected graph of the window's passable cells; multi-source Dijkstra (unit steps)
+    # 8-connected graph of the window's passable cells; multi-source Dijkstra
     flat = np.arange(Hw * Ww).reshape(Hw, Ww)
-    right = passable[:, :-1] & passable[:, 1:]
-    down = passable[:-1, :] & passable[1:, :]
-    i = np.concatenate([flat[:, :-1][right], flat[:-1, :][down]])
-    j = np.concatenate([flat[:, 1:][right], flat[1:, :][down]])
+    i, j, w = [], [], []
+    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
+        lo, hi = max(0, -dc), Ww - max(0, dc)
+        a, b = passable[0:Hw - dr, lo:hi], passable[dr:Hw, lo + dc:hi + dc]
+        both = a & b
+        if dr and dc:  # a diagonal step needs both side cells passable (no corner cutting)
+            both &= passable[dr:Hw, lo:hi] & passable[0:Hw - dr, lo + dc:hi + dc]
+        i.append(flat[0:Hw - dr, lo:hi][both])
+        j.append(flat[dr:Hw, lo + dc:hi + dc][both])
+        w.append(np.full(int(both.sum()), np.sqrt(2.0) if dr and dc else 1.0))
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    graph = coo_matrix((np.ones(i.size), (i, j)), shape=(Hw * Ww, Hw * Ww)).tocsr()
+    graph = coo_matrix((np.concatenate(w), (np.concatenate(i), np.concatenate(j))), shape=(Hw * Ww, Hw * Ww)).tocsr()
     start = flat[src[:, 0], src[:, 1]]
     # the first source of each cell wins ties, as "lower index" (sources are visited in order)
     order = np.argsort(src_idx, kind="stable")
