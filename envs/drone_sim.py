@@ -74,6 +74,7 @@ class Flight:
     duration: float  # simulated seconds
     path: np.ndarray  # (K, 3) positions at every sub-step
     min_clearance: float  # nearest LiDAR obstacle return seen during the segment
+    contact: np.ndarray | None = None  # (3,) the touched point of the obstacle (or ground) on a collision
 
 
 def lidar_directions(channels: int, azimuths: int, vfov_deg: float, offset: float = 0.0) -> np.ndarray:
@@ -129,6 +130,7 @@ class DroneSim:
         self.collisions = 0
         self.crashed = False
         self.scans = 0
+        self.last_contact = None
         self.path = [self.position.copy()]
         self._place(self.position)
         return self.position.copy()
@@ -156,17 +158,22 @@ class DroneSim:
 
     # ------------------------------------------------------------------ contact
     def contact(self, pos) -> bool:
-        """True when the drone sphere at ``pos`` touches a shape or the ground (pybullet closest points)."""
+        """True when the drone sphere at ``pos`` touches a shape or the ground (pybullet closest
+        points); the touched point is then kept in ``last_contact`` (the impact point a simulator's
+        collision report gives)."""
         r = self.config.radius
         pos = np.asarray(pos, float)
         if pos[2] <= r:
+            self.last_contact = np.array([pos[0], pos[1], 0.0])
             return True
         near = np.flatnonzero(((self.lo - r - 0.05) <= pos).all(1) & ((self.hi + r + 0.05) >= pos).all(1))
         if len(near) == 0:
             return False
         self._place(pos)
         for k in near:
-            if p.getClosestPoints(self.drone, self.bodies[k], 0.0, physicsClientId=self.client):
+            pts = p.getClosestPoints(self.drone, self.bodies[k], 0.0, physicsClientId=self.client)
+            if pts:
+                self.last_contact = np.asarray(pts[0][6], float)  # position on the obstacle
                 return True
         return False
 
@@ -203,7 +210,8 @@ class DroneSim:
         Stops early on a collision (counted; the drone stays at its last free position) or, when
         ``replan_distance`` is given, once a LiDAR scan taken in flight every ``scan_every``
         sub-steps shows an obstacle within that distance (the original's "obstacle_detected"
-        replan). ``on_scan(scan, position)`` sees every in-flight scan.
+        replan). ``on_scan(scan, position)`` sees every in-flight scan. On a collision the
+        returned flight's ``contact`` is the touched point.
         """
         c = self.config
         v = c.speed if speed is None else float(speed)
@@ -216,12 +224,14 @@ class DroneSim:
         collided = replanned = False
         t0 = self.time
         min_clear = np.inf
+        touched = None
         k = 0
         for k in range(1, n + 1):
             nxt = start + delta * (k / n)
             if self.contact(nxt):
                 self.collisions += 1
                 collided = True
+                touched = self.last_contact.copy()
                 if c.end_on_collision:
                     self.crashed = True
                 self.time += c.dt
@@ -241,7 +251,7 @@ class DroneSim:
         self.path.extend(path[1:])
         reached = (not collided and not replanned and k == n)
         return Flight(start, self.position.copy(), reached, collided, replanned, self.time - t0,
-                      np.array(path), float(min_clear))
+                      np.array(path), float(min_clear), touched)
 
     def advance(self, seconds: float) -> None:
         """Let the clock run (hovering, e.g. while a planning call is served)."""

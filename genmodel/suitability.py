@@ -23,6 +23,7 @@ NO_OBSTACLE_CLEARANCE = 10.0  # m: clearance reported when no obstacle is sensed
 DENSITY_RADIUS = 5.0  # m: state density counts obstacles within this radius
 WAYPOINT_DENSITY_RADIUS = 3.0  # m: per-waypoint density (simulate_transition)
 WAYPOINT_DENSITY_VOLUME = 113.1  # m^3 = 4/3 pi 3^3, as the original divides
+BLOCKED_PATH = 0.5  # m: a straight path this close to a voxel is blocked (drone radius 0.25 m plus a margin)
 
 # suitability constants (Planning module at e98ed45)
 W_OBSTACLE = 0.8
@@ -106,20 +107,43 @@ def segments_clear(starts, end, voxels, margin: float = 1.5) -> np.ndarray:
     return (d2 > margin * margin).all(0)
 
 
+def path_clearances(start, ends, voxels) -> np.ndarray:
+    """Per end point (N, 3): the least distance from the straight segment ``start`` -> end to a voxel
+    (inf without voxels). It is at most the clearance of either end."""
+    B = np.asarray(ends, float).reshape(-1, 3)
+    v = np.asarray(voxels, float).reshape(-1, 3)
+    if len(v) == 0 or len(B) == 0:
+        return np.full(len(B), np.inf)
+    a = np.asarray(start, float)
+    ab = B - a  # (N, 3)
+    L2 = np.maximum((ab * ab).sum(1), 1e-12)
+    va = v - a  # (M, 3)
+    proj = va @ ab.T  # (M, N): (v - a).ab
+    t = np.clip(proj / L2[None, :], 0.0, 1.0)
+    d2 = (va * va).sum(1)[:, None] - 2.0 * t * proj + t * t * L2[None, :]  # |v - a - t ab|^2
+    return np.sqrt(np.maximum(d2, 0.0).min(0))
+
+
 def segment_clear(a, b, voxels, margin: float = 1.5) -> bool:
     """True when no voxel lies within ``margin`` of the segment a -> b."""
     return bool(segments_clear(np.asarray(a, float)[None], b, voxels, margin)[0])
 
 
-def waypoint_suitability(waypoints, voxels, d_obs_now: float, target, position) -> np.ndarray:
+def waypoint_suitability(waypoints, voxels, d_obs_now: float, target, position,
+                         along_path: bool = False) -> np.ndarray:
     """Per-waypoint suitability as ``simulate_transition`` computes it (DRONE.md 2.3).
 
     Clearance d = min(current d_obs, min |waypoint - voxel|) (the current d_obs caps every
-    candidate, a quirk kept on purpose); density = #voxels within 3 m / 113.1 m^3, inflated by
-    (1 + 0.5 max_octant / nearby) when more than 5 voxels are within 3 m and an octant holds more
-    than 5 within 5 m (then d *= 0.85 if max_octant > 10 and d > 1.5). Near the target (< 10 m),
-    waypoints that reduce the distance get +0.2 * proximity factor when the direct path is clear
-    or the target is under 5 m away, and +0.3 (1 - d_tgt / 2) under 2 m. Returns S clipped to [0, 1].
+    candidate, a quirk kept on purpose); with ``along_path`` the clearance of the whole straight
+    transition, min(current d_obs, :func:`path_clearances`), so a waypoint behind an obstacle the
+    drone would fly through is not suitable (the published code looks at the two ends only), and a
+    waypoint whose path passes within :data:`BLOCKED_PATH` of a voxel, closer than the drone is
+    now, gets none of the near-target bonuses below (it cannot be reached). Density = #voxels
+    within 3 m / 113.1 m^3, inflated by (1 + 0.5 max_octant / nearby) when more than 5 voxels are
+    within 3 m and an octant holds more than 5 within 5 m (then d *= 0.85 if max_octant > 10 and
+    d > 1.5). Near the target (< 10 m), waypoints that reduce the distance get +0.2 * proximity
+    factor when the direct path is clear or the target is under 5 m away, and +0.3 (1 - d_tgt / 2)
+    under 2 m. Returns S clipped to [0, 1].
     """
     W = np.asarray(waypoints, float).reshape(-1, 3)
     v = np.asarray(voxels, float).reshape(-1, 3)
@@ -128,9 +152,14 @@ def waypoint_suitability(waypoints, voxels, d_obs_now: float, target, position) 
     n = len(W)
     d = np.full(n, float(d_obs_now))
     rho = np.zeros(n)
+    reachable = np.ones(n, bool)
     if len(v):
         dist2 = _sq_dists(W, v)
         d = np.minimum(d, np.sqrt(dist2.min(1)))
+        if along_path:
+            along = path_clearances(pos, W, v)
+            d = np.minimum(d, along)
+            reachable = (along >= BLOCKED_PATH) | (along >= float(d_obs_now) - 1e-9)  # or no closer than now
         near3 = dist2 <= WAYPOINT_DENSITY_RADIUS ** 2
         nearby = near3.sum(1)
         rho = nearby / WAYPOINT_DENSITY_VOLUME
@@ -145,7 +174,7 @@ def waypoint_suitability(waypoints, voxels, d_obs_now: float, target, position) 
     d_now = float(np.linalg.norm(tgt - pos))
     d_new = np.linalg.norm(tgt - W, axis=1)
     if d_now < 10.0:
-        red = np.flatnonzero(d_new < d_now)
+        red = np.flatnonzero((d_new < d_now) & reachable)
         clear = segments_clear(W[red], tgt, v) if d_now >= 5.0 else np.ones(len(red), bool)
         for i, ok in zip(red, clear, strict=True):
             if ok:

@@ -12,6 +12,7 @@ MAX_DISTANCE = 125.0
 W_PRAGMATIC = 1.0  # ActionPlanner defaults of the paper
 W_EPISTEMIC = 0.2
 TAU = 0.4  # suitability threshold of the preference: the server's safety_margin / 5 with a 2 m margin
+NOVELTY_WIDTH = 1.0  # m: kernel width of a visit (the shortest step a planning call returns)
 
 
 def distance_preference(d):
@@ -48,12 +49,34 @@ def distance_bonus(d_now: float, d_new):
     return np.maximum(0.0, (d_now - np.asarray(d_new, float)) / max(d_now, 1e-9))
 
 
+def visit_counts(waypoints, visited, width: float = NOVELTY_WIDTH):
+    """Kernel visit counts n(w) = sum_k exp(-|w - p_k|^2 / (2 width^2)) of waypoints ``(M, 3)`` over
+    the positions ``visited`` ``(K, 3)`` (zeros without visits)."""
+    W = np.asarray(waypoints, float).reshape(-1, 3)
+    P = np.asarray(visited, float).reshape(-1, 3) if visited is not None else np.zeros((0, 3))
+    if len(P) == 0 or len(W) == 0:
+        return np.zeros(len(W))
+    d2 = ((W[:, None, :] - P[None, :, :]) ** 2).sum(-1)
+    return np.exp(-0.5 * d2 / (width * width)).sum(1)
+
+
+def novelty(waypoints, visited, width: float = NOVELTY_WIDTH, prior_count: float = 1.0):
+    """Novelty eta(w) = a0 / (a0 + n(w)) in (0, 1] of each waypoint: 1 where the drone has not been,
+    halved by one visit, decaying as 1 / n with more (the information still to gain about a place
+    whose Dirichlet visit count is a0 + n; a0 = ``prior_count``). See :func:`visit_counts`."""
+    n = visit_counts(waypoints, visited, width)
+    return prior_count / (prior_count + n)
+
+
 def efe(pref, bonus, magnitude, entropy_sum: float, w_pragmatic: float = W_PRAGMATIC,
-        w_epistemic: float = W_EPISTEMIC):
-    """G = -w_prag (pref + bonus) |a| - w_epi 0.5 (H_d + H_az + H_el) |a|; returns (G, pragmatic,
-    epistemic). The entropies are the same for every candidate, so the epistemic term rewards step
-    length (as in the original)."""
-    m = np.asarray(magnitude, float)
+        w_epistemic: float = W_EPISTEMIC, novelty=1.0):
+    """G = eta (-w_prag (pref + bonus) |a| - w_epi 0.5 (H_d + H_az + H_el) |a|); returns (G, pragmatic,
+    epistemic). With ``novelty`` eta = 1 this is the paper's EFE: the entropies are the same for
+    every candidate, so the epistemic term rewards step length. With eta < 1 (:func:`novelty`, per
+    candidate) both terms decay at places already visited: the information still to gain there is
+    smaller, and the preference for a predicted state is discounted by how often the drone has
+    already been there (inhibition of return)."""
+    m = np.asarray(magnitude, float) * np.asarray(novelty, float)
     prag = -w_pragmatic * (np.asarray(pref, float) + np.asarray(bonus, float)) * m
     epi = -w_epistemic * 0.5 * float(entropy_sum) * m
     return prag + epi, prag, epi

@@ -43,36 +43,41 @@ def _segment_distance(a, b, V) -> float:
     return float(np.sqrt((((V - a) - t[:, None] * ab) ** 2).sum(1).min()))
 
 
-def _value(pos, tgt, V, entropy_sum, d_start, rng, cfg, look, depth) -> float:
-    """Best discounted sum of shaped EFE over ``depth`` more steps from ``pos`` (lower is better)."""
+def _value(pos, tgt, V, entropy_sum, d_start, rng, cfg, look, depth, visited) -> float:
+    """Best discounted sum of shaped EFE over ``depth`` more steps from ``pos`` (lower is better);
+    ``visited`` holds the positions visited before ``pos`` (the sequence's own earlier steps included)."""
     d_obs = clearance(pos, V)
     rho = density(pos, V)
     s = float(suitability(d_obs, rho))
     if np.linalg.norm(tgt - pos) <= 1.5:
         return 0.0
-    res = plan_waypoints(pos, tgt, V, d_obs, rho, s, entropy_sum, d_start, rng, cfg)
+    res = plan_waypoints(pos, tgt, V, d_obs, rho, s, entropy_sum, d_start, rng, cfg, visited)
     best = 0.0
     for w, g in zip(res.actions[: look.beam], res.efe[: look.beam], strict=False):
         if _segment_distance(pos, w, V) < look.segment_margin:
             continue
         v = float(g)
         if depth > 1:
-            v += look.discount * _value(w, tgt, V, entropy_sum, d_start, rng, cfg, look, depth - 1)
+            v += look.discount * _value(w, tgt, V, entropy_sum, d_start, rng, cfg, look, depth - 1,
+                                        np.vstack([visited, pos]))
         best = min(best, v)
     return best
 
 
 def plan_sequence(position, target, voxels, d_obs: float, rho: float, s_now: float, entropy_sum: float,
                   d_start: float, rng: np.random.Generator, config: DronePlannerConfig | None = None,
-                  lookahead: LookaheadConfig | None = None) -> tuple[PlanResult, np.ndarray]:
+                  lookahead: LookaheadConfig | None = None, visited=None) -> tuple[PlanResult, np.ndarray]:
     """One decision with lookahead; returns the one-step :class:`PlanResult` reordered by sequence
-    value (the first action is the one to fly) and the sequence values of its actions."""
+    value (the first action is the one to fly) and the sequence values of its actions. ``visited``
+    (K, 3): positions of the episode's earlier decisions (the novelty of the epistemic term); each
+    sequence step also counts the sequence's earlier positions as visited."""
     cfg = config or DronePlannerConfig()
     look = lookahead or LookaheadConfig()
     pos = np.asarray(position, float)
     tgt = np.asarray(target, float)
     V = np.asarray(voxels, float).reshape(-1, 3)
-    first = plan_waypoints(pos, tgt, V, d_obs, rho, s_now, entropy_sum, d_start, rng, cfg)
+    visited = np.zeros((0, 3)) if visited is None else np.asarray(visited, float).reshape(-1, 3)
+    first = plan_waypoints(pos, tgt, V, d_obs, rho, s_now, entropy_sum, d_start, rng, cfg, visited)
     n = min(len(first.actions), look.beam)
     values = np.zeros(n)
     ok = np.ones(n, bool)
@@ -81,7 +86,8 @@ def plan_sequence(position, target, voxels, d_obs: float, rho: float, s_now: flo
         ok[i] = _segment_distance(pos, w, V) >= look.segment_margin
         values[i] = float(first.efe[i])
         if look.depth > 1:
-            values[i] += look.discount * _value(w, tgt, V, entropy_sum, d_start, rng, cfg, look, look.depth - 1)
+            values[i] += look.discount * _value(w, tgt, V, entropy_sum, d_start, rng, cfg, look, look.depth - 1,
+                                                np.vstack([visited, pos]))
     if not ok.any():
         return first, values
     idx = np.flatnonzero(ok)

@@ -28,7 +28,14 @@ from .drone_waypoints import (
 @dataclass(frozen=True)
 class DronePlannerConfig:
     """``use_filter=False`` is the no-suitability-filter ablation (every candidate is ranked);
-    ``w_epistemic=0`` the no-epistemic ablation."""
+    ``w_epistemic=0`` the no-epistemic ablation.
+
+    Three switches differ from the published planner (``False`` gives its behaviour, see
+    :meth:`published`): ``novelty`` discounts the EFE of a candidate by the novelty of its place
+    (inhibition of return, kernel width ``novelty_width`` metres); ``path_clearance`` takes a
+    candidate's clearance along its whole straight path, not at its two ends; ``keep_ties`` lets the
+    fallback cascade keep every candidate tied for its last place, so the EFE ranking picks among
+    them."""
 
     use_filter: bool = True
     w_pragmatic: float = E.W_PRAGMATIC
@@ -37,6 +44,25 @@ class DronePlannerConfig:
     min_step: float = 1.0  # returned actions are at least this long (m)
     min_altitude: float = 1.0  # candidates below are inside the ground
     voxel_horizon: float = 5.0  # voxels farther than radius + this cannot change a candidate
+    novelty: bool = True  # False: the paper's EFE; True: it decays at visited places
+    novelty_width: float = E.NOVELTY_WIDTH  # m: kernel width of one visit
+    path_clearance: bool = True  # False: clearance at the waypoint (and the drone) only, as published
+    keep_ties: bool = True  # False: the fallback takes the first of equally suitable candidates, as published
+
+    @classmethod
+    def published(cls, **changes) -> DronePlannerConfig:
+        """The published planner: novelty, path clearance and tie keeping off.
+
+        Parameters
+        ----------
+        **changes
+            Further fields to set.
+
+        Returns
+        -------
+        DronePlannerConfig
+        """
+        return cls(**{"novelty": False, "path_clearance": False, "keep_ties": False, **changes})
 
 
 @dataclass
@@ -53,10 +79,13 @@ class PlanResult:
 
 
 def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: float, entropy_sum: float,
-                   d_start: float, rng: np.random.Generator, config: DronePlannerConfig | None = None) -> PlanResult:
+                   d_start: float, rng: np.random.Generator, config: DronePlannerConfig | None = None,
+                   visited=None) -> PlanResult:
     """The planning step; see the module docstring. ``voxels`` are obstacle voxel centres (M, 3),
     ``d_obs``, ``rho``, ``s_now`` the current clearance, density and suitability, ``d_start`` the
-    distance to the target at the start of the episode (journey bonus)."""
+    distance to the target at the start of the episode (journey bonus), ``visited`` the positions
+    (K, 3) of the earlier decisions of the episode (the novelty of the epistemic term; none: every
+    candidate is novel)."""
     cfg = config or DronePlannerConfig()
     pos = np.asarray(position, float)
     tgt = np.asarray(target, float)
@@ -72,9 +101,10 @@ def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: fl
     V = np.asarray(voxels, float).reshape(-1, 3)
     if len(V):
         V = V[((V - pos) ** 2).sum(1) <= (r + cfg.voxel_horizon) ** 2]
-    S = waypoint_suitability(W, V, d_obs, tgt, pos)
+    S = waypoint_suitability(W, V, d_obs, tgt, pos, along_path=cfg.path_clearance)
     if cfg.use_filter:
-        keep, rule = filter_waypoints(W, S, pos, tgt, rho, path_clear=lambda idx: segments_clear(W[idx], tgt, V))
+        keep, rule = filter_waypoints(W, S, pos, tgt, rho, path_clear=lambda idx: segments_clear(W[idx], tgt, V),
+                                      keep_ties=cfg.keep_ties)
     else:
         keep, rule = np.arange(len(W)), "no filter"
     W, S = W[keep], S[keep]
@@ -89,7 +119,8 @@ def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: fl
     az = np.arctan2(np.sin(az), np.cos(az))
     el = np.arctan2(to_t[:, 2], np.hypot(to_t[:, 0], to_t[:, 1])) - pitch
     pref = E.preference(d_new, az, el, S, cfg.tau)
-    G, _, _ = E.efe(pref, E.distance_bonus(d_now, d_new), mag, entropy_sum, cfg.w_pragmatic, cfg.w_epistemic)
+    eta = E.novelty(W, visited, cfg.novelty_width) if cfg.novelty else 1.0
+    G, _, _ = E.efe(pref, E.distance_bonus(d_now, d_new), mag, entropy_sum, cfg.w_pragmatic, cfg.w_epistemic, eta)
     G = E.shape(G, S, d_now, d_new, mag, rho, d_obs, d_start)
     efe_us = 1e6 * (time.perf_counter() - t0) / max(len(W), 1)
     long_enough = np.flatnonzero(mag >= cfg.min_step)

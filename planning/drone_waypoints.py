@@ -82,7 +82,19 @@ def candidate_waypoints(position, target, radius: float, n: int, rng: np.random.
     return W[W[:, 2] >= min_altitude]
 
 
-def filter_waypoints(W, S, position, target, rho_now: float, path_clear=None) -> tuple[np.ndarray, str]:
+def _best(idx, S, k: int | None, keep_ties: bool) -> np.ndarray:
+    """The ``k`` (all if None) indices of ``idx`` with the highest S, best first; with ``keep_ties``
+    also every other index whose S equals the k-th best (an argmax over a tie is the whole tie)."""
+    idx = idx[np.argsort(-S[idx], kind="stable")]
+    if k is None or len(idx) <= k:
+        return idx
+    if keep_ties:
+        return idx[S[idx] >= S[idx[k - 1]] - 1e-12]
+    return idx[:k]
+
+
+def filter_waypoints(W, S, position, target, rho_now: float, path_clear=None,
+                     keep_ties: bool = False) -> tuple[np.ndarray, str]:
     """Indices of the waypoints kept by the suitability filter and the rule that kept them.
 
     1. keep S >= 0.75 (0.6 within 10 m of the target);
@@ -91,7 +103,10 @@ def filter_waypoints(W, S, position, target, rho_now: float, path_clear=None) ->
     3. add up to 8 more that reduce the distance by at least 5 %;
     4. if none pass: the top 3 above 0.4, else 0.3, else 0.2, else the argmax of S.
     ``path_clear(indices) -> bool array`` tells whether those waypoints' direct paths to the target
-    are clear (only asked when rho > 0.3).
+    are clear (only asked when rho > 0.3). With ``keep_ties`` the fallback keeps every waypoint tied
+    with its third best (or its best), so the EFE ranking, not the candidates' order, picks among
+    equally suitable waypoints; the published code takes the first ones (when the current clearance
+    caps every candidate, these are the ring's first, straight-down, points).
     """
     W = np.asarray(W, float)
     S = np.asarray(S, float)
@@ -119,5 +134,5 @@ def filter_waypoints(W, S, position, target, rho_now: float, path_clear=None) ->
     for t in FALLBACK:
         idx = np.flatnonzero(S >= t)
         if len(idx):
-            return idx[np.argsort(-S[idx], kind="stable")[:3]], f"fallback {t}"
-    return np.array([int(np.argmax(S))]), "fallback argmax"
+            return _best(idx, S, 3, keep_ties), f"fallback {t}"
+    return _best(np.arange(len(S)), S, 1, keep_ties), "fallback argmax"

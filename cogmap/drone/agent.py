@@ -121,6 +121,10 @@ class DroneAgentConfig:
         ... or when the density exceeds this.
     depth : int
         1: the paper's one-step ranking; 2 or 3: EFE over waypoint sequences (beyond the paper).
+    contact_memory : bool
+        True (default): the touched point of every collision stays an obstacle voxel for the rest
+        of the episode (a contact is an observation; the LiDAR's +-10 deg fan misses obstacles just
+        above or below the drone). False: contacts are not perceived, as published.
     """
     planner: DronePlannerConfig = field(default_factory=DronePlannerConfig)
     persistent_beliefs: bool = False  # False: per-call re-initialisation, as published
@@ -129,6 +133,22 @@ class DroneAgentConfig:
     near_goal: float = 10.0  # slow down within this distance of the target
     dense: float = 0.1  # ... or when the density exceeds this
     depth: int = 1  # 1: the paper's one-step ranking; 2 or 3: EFE over waypoint sequences (beyond the paper)
+    contact_memory: bool = True  # False: collisions are not perceived, as published
+
+    @classmethod
+    def published(cls, **changes) -> DroneAgentConfig:
+        """The published agent: :meth:`DronePlannerConfig.published` and no contact memory.
+
+        Parameters
+        ----------
+        **changes
+            Further fields to set.
+
+        Returns
+        -------
+        DroneAgentConfig
+        """
+        return cls(**{"planner": DronePlannerConfig.published(), "contact_memory": False, **changes})
 
     def to_dict(self) -> dict:
         """The settings as a nested dict (for run records).
@@ -177,8 +197,18 @@ class DroneAgent:
         self.speeds = speeds
         self.reset()
 
+    def settings(self) -> dict:
+        """The agent's settings (for run records and run keys): its config and speeds.
+
+        Returns
+        -------
+        dict
+        """
+        return {"policy": "agent", **self.config.to_dict(), "speeds": list(self.speeds)}
+
     def reset(self, target=None, start=None) -> None:
-        """Start an episode: empty voxel memory and beliefs; remember the start-to-target distance if given.
+        """Start an episode: empty voxel memory, visits, contacts and beliefs; remember the
+        start-to-target distance if given.
 
         Parameters
         ----------
@@ -189,6 +219,8 @@ class DroneAgent:
         """
         self.voxels = VoxelMap(memory=self.config.scan_memory)
         self.beliefs = None
+        self.visited: list[np.ndarray] = []  # positions of the episode's earlier decisions
+        self.contacts: list[np.ndarray] = []  # touched points of the episode's collisions
         self.d_start = None
         if target is not None and start is not None:
             self.d_start = float(np.linalg.norm(np.asarray(target, float) - np.asarray(start, float)))
@@ -205,6 +237,17 @@ class DroneAgent:
         """
         self.voxels.add(scan.points)
 
+    def observe_contact(self, point) -> None:
+        """Remember the touched point of a collision as an obstacle voxel (with ``contact_memory``).
+
+        Parameters
+        ----------
+        point : array_like
+            ``(3,)`` the touched point, metres, world frame.
+        """
+        if self.config.contact_memory and point is not None:
+            self.contacts.append(np.asarray(point, float).reshape(3).copy())
+
     def sense(self, position) -> tuple[np.ndarray, float, float, float]:
         """What the drone perceives at ``position``.
 
@@ -216,7 +259,7 @@ class DroneAgent:
         Returns
         -------
         voxels : numpy.ndarray
-            ``(k, 3)`` float voxels within the LiDAR range.
+            ``(k, 3)`` float voxels within the LiDAR range (remembered contacts included).
         d_obs : float
             Clearance to the nearest voxel, metres.
         rho : float
@@ -225,6 +268,10 @@ class DroneAgent:
             Suitability in [0, 1] (DRONE.md formula).
         """
         V = self.voxels.near(position)
+        if self.contacts:
+            C = np.array(self.contacts)
+            C = C[((C - np.asarray(position, float)) ** 2).sum(1) <= SENSE_RADIUS ** 2]
+            V = np.vstack([V, C]) if len(C) else V
         d_obs = clearance(position, V)
         rho = density(position, V)
         return V, d_obs, rho, float(suitability(d_obs, rho))
@@ -260,13 +307,15 @@ class DroneAgent:
         beliefs, _ = self.scheme(self.model, prior, [obs])
         self.beliefs = beliefs
         H = [entropy(b) for b in beliefs]
+        visited = np.array(self.visited).reshape(-1, 3)
         if self.config.depth > 1:
             plan, _ = plan_sequence(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
-                                    self.config.planner, LookaheadConfig(depth=self.config.depth))
+                                    self.config.planner, LookaheadConfig(depth=self.config.depth), visited)
         else:
             plan = plan_waypoints(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
-                                  self.config.planner)
+                                  self.config.planner, visited)
         plan_ms = 1e3 * (time.perf_counter() - t0)
+        self.visited.append(pos.copy())
         d_tgt = float(np.linalg.norm(tgt - pos))
         slow = d_tgt < self.config.near_goal or rho > self.config.dense
         expected = expected_state(self.model, beliefs)

@@ -31,6 +31,15 @@ class StraightLine:
     def __init__(self, step: float = 3.0, speeds=(2.0, 1.5)):
         self.step, self.speeds = step, speeds
 
+    def settings(self) -> dict:
+        """The baseline's parameters (for run records and run keys).
+
+        Returns
+        -------
+        dict
+        """
+        return {"policy": "straight", "step": self.step, "speeds": list(self.speeds)}
+
     def reset(self, target=None, start=None) -> None:
         """Nothing to reset (stateless).
 
@@ -52,6 +61,16 @@ class StraightLine:
             A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
         position : array_like, optional
             Where the scan was taken (unused).
+        """
+        pass
+
+    def observe_contact(self, point) -> None:
+        """Ignore a collision's touched point (the baseline perceives LiDAR returns only).
+
+        Parameters
+        ----------
+        point : array_like
+            ``(3,)`` the touched point, metres, world frame (unused).
         """
         pass
 
@@ -107,6 +126,17 @@ class PotentialField:
         self.min_altitude, self.speeds = min_altitude, speeds
         self.voxels = VoxelMap()
 
+    def settings(self) -> dict:
+        """The baseline's parameters (for run records and run keys).
+
+        Returns
+        -------
+        dict
+        """
+        return {"policy": "potential", "step": self.step, "influence": self.influence, "k_att": self.k_att,
+                "k_rep": self.k_rep, "min_altitude": self.min_altitude, "speeds": list(self.speeds),
+                "scan_memory": self.voxels.scans.maxlen}
+
     def reset(self, target=None, start=None) -> None:
         """Forget the sensed voxels.
 
@@ -130,6 +160,16 @@ class PotentialField:
             Where the scan was taken (unused).
         """
         self.voxels.add(scan.points)
+
+    def observe_contact(self, point) -> None:
+        """Ignore a collision's touched point (the baseline perceives LiDAR returns only).
+
+        Parameters
+        ----------
+        point : array_like
+            ``(3,)`` the touched point, metres, world frame (unused).
+        """
+        pass
 
     def decide(self, position, target) -> Decision:
         """One step along the summed attractive and repulsive force.

@@ -50,8 +50,11 @@ def make_policy(method: str, seed: int = 0):
     Parameters
     ----------
     method : str
-        ``"agent"`` (hierarchical AIF), ``"agent_persistent"`` (beliefs kept across steps),
-        ``"no_filter"``, ``"no_epistemic"``, ``"agent_depth2"`` / ``"agent_depth3"`` (EFE over
+        ``"agent"`` (hierarchical AIF), ``"agent_published"`` (the published planner, without the
+        novelty, path clearance, tie keeping and contact memory of ``"agent"``),
+        ``"agent_persistent"`` (beliefs kept across steps), ``"no_filter"``, ``"no_epistemic"``,
+        ``"no_novelty"`` (the paper's EFE, not discounted at visited places), ``"agent_depth2"`` /
+        ``"agent_depth3"`` (EFE over
         waypoint sequences), ``"straight"`` or ``"potential"``.
     seed : int, optional
         Seed of the agent's planner, default 0 (unused by the baselines).
@@ -73,12 +76,16 @@ def make_policy(method: str, seed: int = 0):
     base = DroneAgentConfig()
     if method == "agent":
         return DroneAgent(base, seed)
+    if method == "agent_published":
+        return DroneAgent(DroneAgentConfig.published(), seed)
     if method == "agent_persistent":
         return DroneAgent(replace(base, persistent_beliefs=True), seed)
     if method == "no_filter":
         return DroneAgent(replace(base, planner=replace(base.planner, use_filter=False)), seed)
     if method == "no_epistemic":
         return DroneAgent(replace(base, planner=replace(base.planner, w_epistemic=0.0)), seed)
+    if method == "no_novelty":
+        return DroneAgent(replace(base, planner=replace(base.planner, novelty=False)), seed)
     if method in ("agent_depth2", "agent_depth3"):
         return DroneAgent(replace(base, depth=int(method[-1])), seed)
     if method == "straight":
@@ -88,8 +95,8 @@ def make_policy(method: str, seed: int = 0):
     raise ValueError(f"unknown drone method {method!r}; choose from {METHODS}")
 
 
-METHODS = ("agent", "agent_persistent", "no_filter", "no_epistemic", "agent_depth2", "agent_depth3", "straight",
-           "potential")
+METHODS = ("agent", "agent_published", "agent_persistent", "no_filter", "no_epistemic", "no_novelty", "agent_depth2",
+           "agent_depth3", "straight", "potential")
 
 
 def _stuck(times, positions, now: float, window: float, dist: float) -> bool:
@@ -108,7 +115,7 @@ def fly_episode(sim, policy, target, limits: EpisodeLimits | None = None, log=No
     sim : DroneSim
         The drone simulator (reset at the start).
     policy : DroneAgent or StraightLine or PotentialField
-        Anything with ``reset``, ``observe``, ``decide`` and ``replans_in_flight``.
+        Anything with ``reset``, ``observe``, ``observe_contact``, ``decide`` and ``replans_in_flight``.
     target : array_like
         ``(3,)`` target position, metres.
     limits : EpisodeLimits, optional
@@ -156,6 +163,8 @@ def fly_episode(sim, policy, target, limits: EpisodeLimits | None = None, log=No
         flight = sim.fly_to(dec.waypoint, dec.speed,
                             replan_distance=replan_d if policy.replans_in_flight else None,
                             on_scan=policy.observe)
+        if flight.contact is not None:
+            policy.observe_contact(flight.contact)
         sim.advance(lim.step_overhead_s)
         steps += 1
         replans += int(flight.replanned)

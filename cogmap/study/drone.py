@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-METHODS = ("agent", "straight", "potential", "no_filter", "no_epistemic", "agent_persistent", "agent_depth2",
-           "agent_depth3")
+METHODS = ("agent", "agent_published", "straight", "potential", "no_filter", "no_epistemic", "no_novelty",
+           "agent_persistent", "agent_depth2", "agent_depth3")
 LEVELS = {"continue": False, "end": True}  # does a collision end the episode?
 FIELD_SEED = 0
 EPISODES = {"full": 149, "reduced": 20, "tiny": 2}
@@ -49,17 +49,19 @@ def drone_plan(scale: str, seeds=None, methods=None, envs=None) -> dict:
 
 
 def drone_specs(plan: dict) -> list[dict]:
+    """One spec per (field, method, setting, episode). A spec's method options are the episode
+    limits and the settings of that method's own policy (``settings()``), so changing the agent
+    changes the keys of the agent's runs and leaves the baselines' runs valid."""
     from dataclasses import asdict
 
-    from cogmap.drone.agent import DroneAgentConfig
-    from cogmap.drone.episode import EpisodeLimits
+    from cogmap.drone.episode import EpisodeLimits, make_policy
 
     from .config import spec_digest
 
     specs = []
     for env in plan["envs"]:
         for method in plan["methods"]:
-            options = {"limits": asdict(EpisodeLimits()), "agent": DroneAgentConfig().to_dict()}
+            options = {"limits": asdict(EpisodeLimits()), "policy": make_policy(method).settings()}
             for level in plan["params"]["levels"]:
                 for seed in plan["seeds"]:
                     spec = {"study": "drone", "scale": plan["scale"], "env": env, "method": method, "seed": int(seed),

@@ -31,3 +31,12 @@ def test_tiny_study_runs_resumes_and_reports(tmp_path):
     assert s2["complete"] and json.loads((tmp_path / "drone" / "study.json").read_text())["sessions"][-1]["ran"] == 0
     after = {p.name: strip_timings(json.loads(p.read_text())["result"]) for p in runs}
     assert before == after
+
+
+def test_a_runs_key_holds_its_own_methods_settings():
+    specs = run_specs(study_plan("drone", "tiny", methods=["agent", "agent_published", "potential"], seeds=[0]))
+    opts = {s["method"]: s["method_options"]["policy"] for s in specs}
+    assert opts["potential"]["policy"] == "potential" and "planner" not in opts["potential"]
+    assert opts["agent"]["planner"]["novelty"] and not opts["agent_published"]["planner"]["novelty"]
+    keys = {(s["method"], s["level"]): s["key"] for s in specs}
+    assert keys[("agent", "continue")].split("__")[-1] != keys[("agent_published", "continue")].split("__")[-1]
