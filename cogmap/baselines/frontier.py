@@ -317,15 +317,7 @@ class FrontierExplorer(BaselinePolicy):
         labels, n = ndimage.label(frontier, structure=np.ones((3, 3)))
         if n == 0:
             return []
-        blocked = coarsen(inflate(occ, (cfg.robot_radius + cfg.inflation_margin) / res), f)
-        rc = m.to_cell(odom[:2]) - np.array([r0, c0])
-        start = (int(np.clip(rc[0] // f, 0, blocked.shape[0] - 1)), int(np.clip(rc[1] // f, 0, blocked.shape[1] - 1)))
-        if blocked[start]:  # squeezed against an obstacle (drift, bumper marks): let the robot leave
-            k = int(np.ceil((cfg.robot_radius + cfg.inflation_margin) / (res * f)))
-            blocked[max(0, start[0] - k):start[0] + k + 1, max(0, start[1] - k):start[1] + k + 1] = False
-        dist, pred = shortest_paths(blocked, start)
-        self._plan = (pred, blocked, (r0, c0))
-        self._dist = dist  # path length (planning cells) from the robot to every cell
+        dist = self.plan_paths(odom, (r0, r1, c0, c1))
         robot = np.asarray(odom[:2], float)
         out = []
         idx = ndimage.find_objects(labels)
@@ -349,6 +341,42 @@ class FrontierExplorer(BaselinePolicy):
             cost = cfg.potential_scale * min_d - cfg.gain_scale * size_m
             out.append(Frontier(cells, size_m, centroid, min_d, goal, path_m, cost))
         return out
+
+    def plan_paths(self, odom, roi, through_unknown: bool = True) -> np.ndarray:
+        """Shortest paths from the robot over the map's inflated planning grid in ``roi``.
+
+        Parameters
+        ----------
+        odom : array_like
+            ``(>=2,)`` robot position in the odometry frame, metres.
+        roi : tuple of int
+            ``(r0, r1, c0, c1)`` map cells planned over (``r0``, ``c0`` aligned to the planning grid).
+        through_unknown : bool, optional
+            Plan through unseen cells (Nav2's ``allow_unknown``, the default); False keeps paths
+            on seen cells.
+
+        Returns
+        -------
+        numpy.ndarray
+            Path length (planning cells) from the robot to every planning cell (inf: unreachable);
+            the predecessors, blocked grid and offset are kept for :meth:`_waypoint`.
+        """
+        cfg, m = self.cfg, self.map
+        res, f = cfg.resolution, cfg.plan_factor
+        r0, r1, c0, c1 = roi
+        blocked = inflate(m.occ[r0:r1, c0:c1], (cfg.robot_radius + cfg.inflation_margin) / res)
+        if not through_unknown:
+            blocked |= ~m.seen[r0:r1, c0:c1]
+        blocked = coarsen(blocked, f)
+        rc = m.to_cell(odom[:2]) - np.array([r0, c0])
+        start = (int(np.clip(rc[0] // f, 0, blocked.shape[0] - 1)), int(np.clip(rc[1] // f, 0, blocked.shape[1] - 1)))
+        if blocked[start]:  # squeezed against an obstacle (drift, bumper marks): let the robot leave
+            k = int(np.ceil((cfg.robot_radius + cfg.inflation_margin) / (res * f)))
+            blocked[max(0, start[0] - k):start[0] + k + 1, max(0, start[1] - k):start[1] + k + 1] = False
+        dist, pred = shortest_paths(blocked, start)
+        self._plan = (pred, blocked, (r0, c0))
+        self._dist = dist  # path length (planning cells) from the robot to every cell
+        return dist
 
     def _blacklisted(self, xy) -> bool:
         return any(np.hypot(*(xy - b)) < self.cfg.blacklist_radius for b in self.blacklist)

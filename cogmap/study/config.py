@@ -10,7 +10,7 @@ from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
 STUDIES = ("exploration", "generalisation", "success", "goals", "drift", "slip", "dropout", "obstacle",
            "scaling", "drone", "dvbf-navigation", "dvbf-exploration")
-METHODS = ("aimapp", "frontier", "frontier_paper", "random", "oracle")
+METHODS = ("aimapp", "frontier", "frontier_paper", "nbv", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
 AIMAPP_VARIANTS = {"aimapp_revisits": {"track_anchors": False}}
@@ -34,6 +34,7 @@ METHOD_OPTIONS = {
     "aimapp_revisits": {"patience": AIMAPP_PATIENCE, "end_rule": AIMAPP_END_RULE},
     "frontier": {"goal": "nearest reachable cell"},
     "frontier_paper": {"goal": "centroid"},
+    "nbv": {"goal": "most unseen area per metre, own map"},
     "random": {},
     "oracle": {},
 }
@@ -54,7 +55,7 @@ def method_options(method: str, env: str) -> dict:
     whose step length, robot radius and LiDAR range the run sets from the simulator)."""
     from dataclasses import asdict
 
-    from cogmap.baselines import FrontierConfig, FrontierPaperConfig, OracleConfig
+    from cogmap.baselines import FrontierConfig, FrontierPaperConfig, NBVConfig, OracleConfig
     from cogmap.explore import default_config
 
     if method not in METHOD_OPTIONS:
@@ -62,7 +63,8 @@ def method_options(method: str, env: str) -> dict:
     config = {"aimapp": lambda: default_config(env).to_dict(),
               "aimapp_revisits": lambda: aimapp_config("aimapp_revisits", env).to_dict(),
               "frontier": lambda: asdict(FrontierConfig()),
-              "frontier_paper": lambda: asdict(FrontierPaperConfig()), "oracle": lambda: asdict(OracleConfig()),
+              "frontier_paper": lambda: asdict(FrontierPaperConfig()), "nbv": lambda: asdict(NBVConfig()),
+              "oracle": lambda: asdict(OracleConfig()),
               "random": dict}[method]()
     return json.loads(json.dumps({**METHOD_OPTIONS[method], "config": config}))
 

@@ -78,4 +78,4 @@ DRIFT_NOTE = "Table 4 values not recoverable from the text; AIMAPP ATE/m about 3
 # our method names -> the paper's
 PAPER_NAME = {"aimapp": "AIMAPP", "aimapp_revisits": "AIMAPP",
               "frontier": "Frontiers", "frontier_paper": "Frontiers", "oracle": "Manual",
-              "random": None}
+              "nbv": None, "random": None}

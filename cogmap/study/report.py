@@ -13,9 +13,10 @@ from .metrics_extra import duplicates, fraction_within, summarise
 METHOD_LABEL = {"aimapp": "AIMAPP", "aimapp_revisits": "AIMAPP (revisits only)",
                 "frontier": "Frontiers (nearest reachable cell)",
                 "frontier_paper": "Frontiers (explore_lite-like)", "random": "Random walk",
+                "nbv": "Next-best view (oracle's rule, own map)",
                 "oracle": "Oracle (manual)"}
 COLORS = {"aimapp": "C0", "aimapp_revisits": "C5", "frontier": "C1", "frontier_paper": "C4", "random": "C2",
-          "oracle": "C3"}
+          "oracle": "C3", "nbv": "C6"}
 CAUSES = ("stuck", "collision", "map")
 
 

@@ -77,6 +77,8 @@ def make_policy(method: str, sim, step: float, seed: int, config: dict | None = 
         FrontierExplorer,
         FrontierPaperConfig,
         FrontierPaperExplorer,
+        NBVConfig,
+        NextBestView,
         OracleConfig,
         OracleTour,
         RandomWalk,
@@ -88,6 +90,8 @@ def make_policy(method: str, sim, step: float, seed: int, config: dict | None = 
         return FrontierExplorer(FrontierConfig(**own))
     if method == "frontier_paper":
         return FrontierPaperExplorer(FrontierPaperConfig(**own))
+    if method == "nbv":
+        return NextBestView(NBVConfig(**own))
     if method == "random":
         return RandomWalk(step, seed=seed)
     if method == "oracle":
@@ -132,7 +136,7 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
 
 #: how a baseline declares itself finished (its ``mode == "done"``)
 BASELINE_END = {"frontier": "no frontier left", "frontier_paper": "no frontier left",
-                "oracle": "no viewpoint worth a detour"}
+                "nbv": "no viewpoint worth a detour", "oracle": "no viewpoint worth a detour"}
 
 
 def exploration_result(spec, sim, ep, ended_by_itself: bool = False, end: dict | None = None) -> dict:
