@@ -177,17 +177,28 @@ def _identity(sim, ep) -> dict:
     return {"start_pose": [round(float(v), 4) for v in sim.path[0]], "trajectory_digest": trajectory_digest(path)}
 
 
-def run_exploration(spec) -> dict:
+def _explore(spec):
+    """The exploration run of ``spec``: (sim, episode, agent-or-policy, ended_by_itself, end)."""
     opts = spec["method_options"]
     # AIMAPP runs with aimapp_config(method, env), which is what its spec records; a baseline's recorded config
     config = opts.get("config") if not spec["method"].startswith("aimapp") else None
     end: dict = {}
-    sim, ep, _, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
-                                        opts.get("patience"), config, _faults(spec), end, opts.get("end_rule"))
+    sim, ep, agent, ended = explore_episode(spec["env"], spec["method"], spec["seed"], spec["steps"], _noise(spec),
+                                            opts.get("patience"), config, _faults(spec), end, opts.get("end_rule"))
+    return sim, ep, agent, ended, end
+
+
+def run_exploration(spec) -> dict:
+    """Both endpoints of one exploration run; with ``spec["goals"]`` (the generalisation study's
+    AIMAPP runs) also the goal runs that follow it (:func:`goal_runs`)."""
+    sim, ep, agent, ended, end = _explore(spec)
     try:
-        return exploration_result(spec, sim, ep, ended, end)
+        out = exploration_result(spec, sim, ep, ended, end)
     finally:
         sim.close()
+    if spec.get("goals"):
+        out["goals"] = goal_runs(spec, agent, spec["goals"])
+    return out
 
 
 def run_drift(spec) -> dict:
@@ -217,23 +228,19 @@ def _choose_goals(agent, start_state: int, k: int, min_dist: float) -> list[tupl
     return [(o, gs) for _, o, gs in cands[:k]]
 
 
-def run_goals(spec) -> dict:
-    """Explore, then from the exploration start (known) pursue stored goal observations."""
+def goal_runs(spec, agent, params: dict) -> list[dict]:
+    """From the exploration start (known, as in the paper's protocol), pursue the stored views
+    farthest from it (``params``: ``goals_per_run``, ``goal_steps``, ``min_goal_distance``), each with
+    a copy of the explored ``agent`` in a fresh simulator; one result per goal."""
     from cogmap.explore import default_config
     from cogmap.goal import pursue
 
-    p = spec["params"]
-    sim, ep, agent, _ = explore_episode(spec["env"], "aimapp", spec["seed"], spec["steps"], None,
-                                        spec["method_options"].get("patience"))
-    explore_cov = float(ep.coverage[-1])
-    ident = _identity(sim, ep)
-    sim.close()
     cfg = default_config(spec["env"])
     base = copy.deepcopy(agent)
     sim = study_sim(spec["env"], cfg, spec["seed"])
     try:
         start_state = base.localise_at(sim.odometry())
-        goals = _choose_goals(base, start_state, p["goals_per_run"], p["min_goal_distance"])
+        goals = _choose_goals(base, start_state, params["goals_per_run"], params["min_goal_distance"])
     finally:
         sim.close()
     results = []
@@ -244,7 +251,7 @@ def run_goals(spec) -> dict:
         try:
             s0 = ag.localise_at(sim.odometry())
             plan_m = graph_plan_length(ag.model.B[0], ag.poses, s0, goal_states, cfg.inductive_threshold)
-            gep, summary = pursue(sim, ag, obs, p["goal_steps"], progress=False)
+            gep, summary = pursue(sim, ag, obs, params["goal_steps"], progress=False)
             res = {"goal": gi, "goal_obs": obs, "goal_states": goal_states, "reached": summary["reached"],
                    "steps": summary["steps"], "executed_m": summary["executed_m"], "astar_m": summary["astar_m"],
                    "plan_m": plan_m,
@@ -252,8 +259,19 @@ def run_goals(spec) -> dict:
             results.append(res)
         finally:
             sim.close()
-    return {"explore_steps": len(ep.rows), "explore_coverage": explore_cov, "num_states": base.num_states,
-            "num_observations": int(base.model.num_obs[0]), "goals": results, **ident}
+    return results
+
+
+def run_goals(spec) -> dict:
+    """Explore, then from the exploration start (known) pursue stored goal observations."""
+    sim, ep, agent, _ = explore_episode(spec["env"], "aimapp", spec["seed"], spec["steps"], None,
+                                        spec["method_options"].get("patience"))
+    explore_cov = float(ep.coverage[-1])
+    ident = _identity(sim, ep)
+    sim.close()
+    results = goal_runs(spec, agent, spec["params"])
+    return {"explore_steps": len(ep.rows), "explore_coverage": explore_cov, "num_states": agent.num_states,
+            "num_observations": int(agent.model.num_obs[0]), "goals": results, **ident}
 
 
 def run_obstacle(spec) -> dict:

@@ -32,6 +32,12 @@ def test_keys_are_distinct_and_carry_every_setting():
         assert other["key"] != base["key"] and other["key"].split("__")[:3] == base["key"].split("__")[:3]
     assert run_specs(study_plan("generalisation", "reduced"))[0]["key"] != base["key"]  # scale is in the key
     assert base["env"] in base["key"] and base["method"] in base["key"] and f"s{base['seed']}" in base["key"]
+    # AIMAPP's runs carry the goal phase that follows exploring; the baselines' keys do not change with it
+    goals = {s["method"]: s.get("goals") for s in specs}
+    assert goals["aimapp"]["goals_per_run"] == 1 and goals["frontier"] is None and goals["oracle"] is None
+    other = run_specs({**plan, "aimapp_goals": {**plan["aimapp_goals"], "goal_steps": 50}})
+    changed = {s["method"] for s, t in zip(specs, other, strict=True) if s["key"] != t["key"]}
+    assert changed == {"aimapp"}
 
 
 def test_building_envs_cycle_kinds_from_the_first_seed():
@@ -59,5 +65,9 @@ def test_tiny_run_writes_rows_with_end_reasons(tmp_path):
     assert aim["steps"] == 6 and aim["end_reason"] == "budget"  # 6 decisions: the budget ends it
     assert isinstance(aim["unvisited_reachable"], int) and aim["unvisited_reachable"] >= 0
     assert runs["oracle"]["result"]["unvisited_reachable"] is None
+    assert "goals" not in runs["oracle"]["result"]
+    assert len(aim["goals"]) == 1  # the stored view farthest from the start, at most 5 decisions at tiny scale
+    assert aim["goals"][0]["steps"] <= 5 and isinstance(aim["goals"][0]["reached"], bool)
     table = (tmp_path / "generalisation" / "table.md").read_text()
     assert "building:corridor:1000" in table and "All buildings pooled" in table and "Target" in table
+    assert "Goal runs after exploring" in table
