@@ -24,6 +24,8 @@ FLOOR_RGBA = (0.55, 0.55, 0.5, 1.0)
 
 
 EYE_OFFSET = (3.7e-7, -2.9e-7, 1.3e-7)  # metres; see PyBulletScene.view
+# metres: no mesh vertex may lie this close to the camera's own plane (see PyBulletScene.view)
+VERTEX_CLEARANCE = 1e-3
 
 
 def _quat(yaw: float):
@@ -87,6 +89,13 @@ class PyBulletScene:
                                        physicsClientId=cid)
         self.names = {v: k for k, v in self.bodies.items()}
         self._proj = {}
+        # horizontal outline vertices of every visual mesh (body frame) and where they are now,
+        # for the camera guard of view()
+        self._outline = {name: _outline(s) for name, s in zip(self.bodies, layout.shapes, strict=True)}
+        self._poses = {s.name: (s.x, s.y, getattr(s, "yaw", 0.0)) for s in layout.shapes}
+        hx, hy = size[0] / 2, size[1] / 2
+        self._floor_xy = np.array([[centre[0] + a * hx, centre[1] + b * hy] for a in (-1, 1) for b in (-1, 1)])
+        self._vertex_xy = None
 
     def _texture(self, body: int, rgb: np.ndarray, path: Path) -> None:
         write_png(path, rgb)
@@ -131,6 +140,20 @@ class PyBulletScene:
     def move_body(self, name: str, x: float, y: float, yaw: float = 0.0) -> None:
         p.resetBasePositionAndOrientation(self.bodies[name], [x, y, self.heights[name] / 2],
                                           _quat(yaw), physicsClientId=self.client)
+        self._poses[name] = (x, y, yaw)
+        self._vertex_xy = None
+
+    def vertex_xy(self) -> np.ndarray:
+        """``(V, 2)`` horizontal positions (metres) of every visual mesh vertex now: the corners
+        of boxes and of the floor, the rim vertices of cylinders."""
+        if self._vertex_xy is None:
+            parts = [self._floor_xy]
+            for name, local in self._outline.items():
+                x, y, yaw = self._poses[name]
+                c, s_ = np.cos(yaw), np.sin(yaw)
+                parts.append(local @ np.array([[c, s_], [-s_, c]]) + np.array([x, y]))
+            self._vertex_xy = np.vstack(parts)
+        return self._vertex_xy
 
     def cast(self, origin_xy, headings, z: float, r_min: float, r_max: float):
         """Horizontal rays from `r_min` to `r_max` around origin at height z.
@@ -155,10 +178,21 @@ class PyBulletScene:
         key = (width, height, fov_deg)
         if key not in self._proj:
             self._proj[key] = p.computeProjectionMatrixFOV(fov_deg, width / height, 0.05, 30.0)
-        # pybullet's TinyRenderer never returns when the eye lies exactly in the plane of a box
-        # face (walls sit on round coordinates, and so do moves on a 1 m lattice): a sub-micron
-        # offset, far below a pixel, keeps the eye off every such plane
-        eye = [float(eye_xy[0]) + EYE_OFFSET[0], float(eye_xy[1]) + EYE_OFFSET[1], z + EYE_OFFSET[2]]
+        # pybullet's TinyRenderer does not clip triangles at the camera: a mesh vertex lying in (or
+        # within a hair of) the camera's own plane, the plane through the eye across the view,
+        # projects to coordinates beyond any integer and the rasteriser never returns. Walls sit
+        # on round coordinates, and so do moves on a lattice, so it happens in ordinary layouts,
+        # from vertices metres to the side. The eye steps back along the view (2 mm at a time,
+        # far below a pixel) until every vertex is VERTEX_CLEARANCE away from that plane; the
+        # sub-micron offset keeps it off exact planes of the lattice as well.
+        eye = np.array([float(eye_xy[0]) + EYE_OFFSET[0], float(eye_xy[1]) + EYE_OFFSET[1], z + EYE_OFFSET[2]])
+        view_dir = np.array([np.cos(heading), np.sin(heading)])
+        xy = self.vertex_xy()
+        for _ in range(16):
+            if not (np.abs((xy - eye[:2]) @ view_dir) < VERTEX_CLEARANCE).any():
+                break
+            eye[:2] -= 2 * VERTEX_CLEARANCE * view_dir
+        eye = eye.tolist()
         tgt = [eye[0] + np.cos(heading), eye[1] + np.sin(heading), eye[2]]
         vm = p.computeViewMatrix(eye, tgt, [0, 0, 1])
         _, _, rgba, _, _ = p.getCameraImage(width, height, vm, self._proj[key],
@@ -176,3 +210,14 @@ class PyBulletScene:
         if self.client is not None and p.isConnected(self.client):
             p.disconnect(self.client)
         self.client = None
+
+
+def _outline(shape, segments: int = 12) -> np.ndarray:
+    """Horizontal vertices (body frame, metres) of a shape's visual mesh: a box's four corners,
+    a cylinder's rim (the ``segments`` of :func:`textures.cylinder_mesh`, which also bound
+    pybullet's own cylinder tessellation closely enough for the camera guard)."""
+    if isinstance(shape, Box):
+        hx, hy = shape.sx / 2, shape.sy / 2
+        return np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+    a = 2 * np.pi * np.arange(segments) / segments
+    return shape.radius * np.stack([np.cos(a), np.sin(a)], axis=1)
