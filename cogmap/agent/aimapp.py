@@ -42,7 +42,7 @@ from .confidence import Confidence, assess, cusum
 from .config import AgentConfig
 from .correction import Anchor, relocalise, to_frame_panorama, track
 from .encoder import Encoder, check_encoder, make_encoder
-from .mapping import direction, expansion_free_energies, reverse_heading
+from .mapping import centre_in_passage, direction, expansion_free_energies, reverse_heading
 from .sensing import blocked
 from .viewmap import ViewMap
 
@@ -758,7 +758,7 @@ class AIMAPPAgent:
                 continue
             if created >= cfg.lookahead_nodes:
                 continue
-            p_star = origin + cfg.influence_radius * direction(h, cfg.num_headings)
+            p_star = self._predicted_pose(origin, h, scan, pose)
             d_near = self.model.pose_index().nearest(p_star)[1]
             if expansion_free_energies(np.array([d_near]), radius, cfg.sigma)[0] < 0:  # Eq. (7)
                 new = m.add_state(0, pose=p_star, obs_count=cfg.prior_count / m.num_obs[0])
@@ -766,6 +766,21 @@ class AIMAPPAgent:
                 learn_transition(m, 0, state, h, new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
                                  rates=cfg.learning)
         return created
+
+    def _predicted_pose(self, origin: np.ndarray, heading: int, scan: np.ndarray | None,
+                        pose: np.ndarray) -> np.ndarray:
+        """Where a move along ``heading`` from the state at ``origin`` is predicted to lead: one
+        influence radius along it, moved to the centre line of a corridor narrower than
+        ``passage_width`` when the LiDAR shows one (and the move there is as free)."""
+        cfg = self.cfg
+        u = direction(heading, cfg.num_headings)
+        p_star = origin + cfg.influence_radius * u
+        if scan is None or cfg.passage_width <= 0:
+            return p_star
+        centred = centre_in_passage(p_star, u, pose + scan, cfg.passage_width, max_shift=0.5 * cfg.influence_radius)
+        if blocked(scan, centred - pose, cfg.robot_radius + cfg.obstacle_margin)[0]:
+            return p_star
+        return centred
 
     def _waypoint(self, state: int, action: int) -> tuple[int, np.ndarray]:
         """Where an action leads: its most probable successor other than staying (as the planner

@@ -36,6 +36,11 @@ class AgentConfig:
     lookahead_nodes : int
         At most this many new states are created per expansion, i.e. per arrival at a state
         (Table 6: 8).
+    passage_width : float
+        Metres. A predicted state in a corridor narrower than this (walls on both sides across
+        the move over a metre along it, from the LiDAR) is placed on the corridor's centre line
+        (:func:`cogmap.agent.mapping.centre_in_passage`), so a corridor holds one row of states;
+        0 places every predicted state one influence radius along its heading, as the paper does.
     ssim_threshold : float
         In [0, 1]. Place recognition by the SSIM encoder: a panorama whose best SSIM against the
         stored views is at least this is the same observation (Table 6: 65 %); also the bar a
@@ -165,6 +170,7 @@ class AgentConfig:
     robot_radius: float = 0.22  # physical radius: collision buffer for state creation
     node_spacing: float = 0.9  # a predicted pose is beyond a node's influence past this x radius
     lookahead_nodes: int = 8  # at most this many new states per expansion (Table 6)
+    passage_width: float = 2.5  # predicted states in narrower corridors go to the centre line (0: off)
     ssim_threshold: float = 0.65  # place recognition (Table 6)
     encoder: str = "ssim"  # observation encoder by name (cogmap.agent.encoder.register_encoder)
     mcts_depth: int = 10  # Appendix A.3
