@@ -633,6 +633,16 @@ def _dvbf_exploration_report(study_dir: Path, plan, results) -> str:
 REPORTS["dvbf-exploration"] = _dvbf_exploration_report
 
 
+def _code_versions(results, code: str) -> str:
+    """``digest: method (runs), ...`` for the runs made with one version of the code."""
+    counts: dict[str, int] = {}
+    for r in results:
+        if r.get("code") == code:
+            m = r.get("spec", {}).get("method", "?")
+            counts[m] = counts.get(m, 0) + 1
+    return f"`{code}` " + ", ".join(f"{m} ({n} runs)" for m, n in sorted(counts.items()))
+
+
 def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
     study_dir = Path(study_dir)
     body = REPORTS[name](study_dir, plan, results)
@@ -642,8 +652,10 @@ def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
             f"(sum of run times {meta['run_wall_s_total']:.0f} s).\n\n")
     codes = sorted({r.get("code") for r in results if r.get("code")})
     if len(codes) > 1:
-        head += (f"**Warning:** the runs were made with {len(codes)} different versions of the code (source digests "
-                 f"{', '.join(codes)}): the tree changed while the study ran.\n\n")
+        head += (f"**Note:** the runs were made with {len(codes)} versions of the code: "
+                 + "; ".join(_code_versions(results, c) for c in codes)
+                 + ". A run is made again when its settings (its key) change, not when code it may not use "
+                 "does.\n\n")
     text = head + body + "\n"
     (study_dir / "table.md").write_text(text)
     return text

@@ -142,3 +142,12 @@ def test_dropout_study_pairs_each_fault_with_the_same_seed_without_one(tmp_path)
     assert rows["none"]["silent_decisions"] == 0
     assert rows["lidar"]["silent_decisions"] == rows["camera"]["silent_decisions"] == 2
     assert "loss vs. no fault" in out["table"] and not out["duplicates"]
+
+
+def test_a_table_names_which_methods_each_version_of_the_code_made():
+    from cogmap.study.report import _code_versions
+
+    results = [{"code": "aa", "spec": {"method": "aimapp"}}, {"code": "aa", "spec": {"method": "aimapp"}},
+               {"code": "bb", "spec": {"method": "oracle"}}, {"code": "bb", "spec": {"method": "frontier"}}]
+    assert _code_versions(results, "aa") == "`aa` aimapp (2 runs)"
+    assert _code_versions(results, "bb") == "`bb` frontier (1 runs), oracle (1 runs)"
