@@ -93,7 +93,7 @@ FAULTS = ("none", "lidar", "camera")  # dropout study: which stream is silent
 GENERAL_SEED0 = 1000
 GENERAL_BUILDINGS = {"full": 20, "reduced": 4}
 GENERAL_STEPS = 300
-GENERAL_METHODS = ("aimapp", "frontier", "oracle")
+GENERAL_METHODS = ("aimapp", "frontier", "nbv", "oracle")
 # after exploring, AIMAPP pursues the stored view farthest from its (known) start (issue: goals in
 # layouts it was never tuned on); part of AIMAPP's run keys only
 GENERAL_GOALS = {"goals_per_run": 1, "goal_steps": 100, "min_goal_distance": 1.5}

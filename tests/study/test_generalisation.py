@@ -10,10 +10,10 @@ from cogmap.study.config import building_envs, run_specs, study_plan
 from cogmap.study.runner import run_study
 
 
-def test_plan_covers_twenty_buildings_three_seeds_and_three_methods():
+def test_plan_covers_twenty_buildings_three_seeds_and_four_methods():
     plan = study_plan("generalisation", "full")
     assert len(plan["envs"]) == 20 and plan["seeds"] == [0, 1, 2]
-    assert plan["methods"] == ["aimapp", "frontier", "oracle"]
+    assert plan["methods"] == ["aimapp", "frontier", "nbv", "oracle"]
     assert set(plan["steps"].values()) == {300}
     seeds = [int(e.split(":")[2]) for e in plan["envs"]]
     assert seeds == list(range(1000, 1020)) and min(seeds) >= 50  # the tests use building seeds 0-49
@@ -25,7 +25,7 @@ def test_plan_covers_twenty_buildings_three_seeds_and_three_methods():
 def test_keys_are_distinct_and_carry_every_setting():
     plan = study_plan("generalisation", "full")
     specs = run_specs(plan)
-    assert len(specs) == 20 * 3 * 3 == len({s["key"] for s in specs})
+    assert len(specs) == 20 * 3 * 4 == len({s["key"] for s in specs})
     base = specs[0]
     for change in ({"steps": {**plan["steps"], base["env"]: 299}}, {"coverage_level": 0.8}):
         other = run_specs({**plan, **change})[0]
@@ -35,6 +35,7 @@ def test_keys_are_distinct_and_carry_every_setting():
     # AIMAPP's runs carry the goal phase that follows exploring; the baselines' keys do not change with it
     goals = {s["method"]: s.get("goals") for s in specs}
     assert goals["aimapp"]["goals_per_run"] == 1 and goals["frontier"] is None and goals["oracle"] is None
+    assert goals["nbv"] is None
     other = run_specs({**plan, "aimapp_goals": {**plan["aimapp_goals"], "goal_steps": 50}})
     changed = {s["method"] for s, t in zip(specs, other, strict=True) if s["key"] != t["key"]}
     assert changed == {"aimapp"}
