@@ -9,7 +9,7 @@ import json
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
 STUDIES = ("exploration", "generalisation", "success", "goals", "drift", "slip", "dropout", "obstacle",
-           "scaling", "drone", "dvbf-navigation", "dvbf-exploration")
+           "scaling", "drone", "dvbf-navigation", "dvbf-exploration", "dvbf-slam")
 METHODS = ("aimapp", "frontier", "frontier_paper", "nbv", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -126,6 +126,10 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
         from .dvbf_exploration import dvbf_exploration_plan
 
         return dvbf_exploration_plan(scale, seeds=seeds, methods=methods, envs=envs)
+    if study == "dvbf-slam":  # SLAM traversals of LiDAR mazes (cogmap.study.dvbf_slam)
+        from .dvbf_slam import dvbf_slam_plan
+
+        return dvbf_slam_plan(scale, seeds=seeds, methods=methods, envs=envs)
     full = scale == "full"
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
@@ -231,6 +235,10 @@ def run_specs(plan: dict) -> list[dict]:
         from .dvbf_exploration import dvbf_exploration_specs
 
         return dvbf_exploration_specs(plan)
+    if plan["study"] == "dvbf-slam":
+        from .dvbf_slam import dvbf_slam_specs
+
+        return dvbf_slam_specs(plan)
     unknown = [m for m in plan["methods"] if m not in METHOD_OPTIONS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; choose from {list(METHOD_OPTIONS)}")

@@ -633,6 +633,15 @@ def _dvbf_exploration_report(study_dir: Path, plan, results) -> str:
 REPORTS["dvbf-exploration"] = _dvbf_exploration_report
 
 
+def _dvbf_slam_report(study_dir: Path, plan, results) -> str:
+    from .dvbf_slam import dvbf_slam_report
+
+    return dvbf_slam_report(study_dir, plan, results)
+
+
+REPORTS["dvbf-slam"] = _dvbf_slam_report
+
+
 def _code_versions(results, code: str) -> str:
     """``digest: method (runs), ...`` for the runs made with one version of the code."""
     counts: dict[str, int] = {}

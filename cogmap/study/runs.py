@@ -396,11 +396,17 @@ def run_dvbf_exploration(spec) -> dict:
     return run(spec)
 
 
+def run_dvbf_slam(spec) -> dict:
+    from .dvbf_slam import run_dvbf_slam as run
+
+    return run(spec)
+
+
 RUNNERS = {"exploration": run_exploration, "generalisation": run_exploration, "success": run_exploration,
            "goals": run_goals, "drift": run_drift,
            "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
            "drone": run_drone, "dvbf-navigation": run_dvbf_navigation,
-           "dvbf-exploration": run_dvbf_exploration}
+           "dvbf-exploration": run_dvbf_exploration, "dvbf-slam": run_dvbf_slam}
 
 
 _DIGEST: str | None = None
