@@ -1,0 +1,39 @@
+"""``cogmap reproduce dvbf-slam``: plan, distinct keys, a tiny run, its report, and bad input."""
+
+import numpy as np
+import pytest
+
+from cogmap.study import run_study
+from cogmap.study.config import run_specs, study_plan
+from cogmap.study.runner import load_runs
+
+
+def test_full_plan_is_six_mazes_by_four_traversals_with_distinct_keys():
+    specs = run_specs(study_plan("dvbf-slam", "full"))
+    assert len(specs) == 24 and len({s["key"] for s in specs}) == 24
+    assert {s["env"] for s in specs} == {f"maze{m}" for m in range(1, 7)}
+    assert all(s["steps"] == 3000 and s["params"]["pretrain_maze"] == 0 for s in specs)
+
+
+def test_bad_input_is_refused():
+    with pytest.raises(ValueError, match="pretrains"):
+        study_plan("dvbf-slam", "tiny", envs=["maze0"])
+    with pytest.raises(ValueError, match="maze<seed>"):
+        study_plan("dvbf-slam", "tiny", envs=["house"])
+    with pytest.raises(ValueError, match="one method"):
+        study_plan("dvbf-slam", "tiny", methods=["offline"])
+
+
+def test_tiny_study_runs_resumes_and_reports(tmp_path):
+    first = run_study("dvbf-slam", tmp_path, scale="tiny", progress=False)
+    assert first["complete"] and first["runs"] == 1
+    stored = load_runs(tmp_path / "dvbf-slam")
+    assert run_study("dvbf-slam", tmp_path, scale="tiny", progress=False)["runs"] == 1
+    assert load_runs(tmp_path / "dvbf-slam") == stored  # nothing redone
+    (result,) = [r["result"] for r in stored.values()]
+    curve = np.array(result["error_curve"])
+    assert curve.shape == (3,) and curve[0] < 1e-2  # every 10th of 30 steps; the start is known
+    assert result["error_final"] >= 0 and 0 <= result["better_than_pi_share"] <= 1
+    table = (tmp_path / "dvbf-slam" / "table.md").read_text()
+    assert "paper: online" in table and "0.03 ± 0.02" in table and "**Target:**" in table
+    assert (tmp_path / "dvbf-slam" / "error.png").is_file()
