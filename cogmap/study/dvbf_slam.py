@@ -61,6 +61,7 @@ def dvbf_slam_specs(plan: dict) -> list[dict]:
 
     from .config import spec_digest
 
+    # filter and training settings for the key; the map grid and emission size come from the maze in slam_run
     config = SLAMConfig(**plan["params"]["overrides"]).to_json()
     specs = []
     for env in plan["envs"]:
@@ -157,11 +158,14 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
     fig.tight_layout()
     fig.savefig(study_dir / "error.png", dpi=100)
     plt.close(fig)
+    spec0 = results[0]["spec"]
+    noise = spec0["noise"]
     note = ("Each cell: DVBF-LM online SLAM / path integration, localisation error (distance of the particle mean "
             "to the true position) in units of the maze side (1). Emission pretrained with known poses on a "
             f"{plan['params']['pretrain_steps']}-step traversal of maze 0 ({plan['params']['pretrain_iters']} Adam "
-            "steps) and frozen, then 20 particles and online q(M) learning (`cogmap dvbf slam` defaults); actuation "
-            "noise turn std 0.005 rad, forward 5 %. The shaded bands in error.png are the 25-75 % range over runs. "
+            f"steps) and frozen, then {spec0['method_options']['slam']['n_particles']} particles and online q(M) "
+            f"learning (`cogmap dvbf slam` defaults); actuation noise turn std {noise['rot_std']:g} rad, forward "
+            f"{100 * noise['trans_frac']:g} %. The shaded bands in error.png are the 25-75 % range over runs. "
             "The paper's traversals come from human operators, ours from the seeded operator "
             "(`cogmap.envs.maze_traversal`). Offline SLAM and a Cartographer stand-in are not built.")
     return (_md(summary_header, summary) + "\n\n" + target + "\n\n" + _md(header, table) + "\n\n" + note

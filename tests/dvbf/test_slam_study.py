@@ -33,7 +33,8 @@ def test_tiny_study_runs_resumes_and_reports(tmp_path):
     (result,) = [r["result"] for r in stored.values()]
     curve = np.array(result["error_curve"])
     assert curve.shape == (3,) and curve[0] < 1e-2  # every 10th of 30 steps; the start is known
-    assert result["error_final"] >= 0 and 0 <= result["better_than_pi_share"] <= 1
+    assert result["error_final"] <= result["error_max"] and result["error_mean"] <= result["error_max"]
+    assert 0 <= result["better_than_pi_share"] <= 1
     table = (tmp_path / "dvbf-slam" / "table.md").read_text()
     assert "paper: online" in table and "0.03 ± 0.02" in table and "**Target:**" in table
     assert (tmp_path / "dvbf-slam" / "error.png").is_file()
