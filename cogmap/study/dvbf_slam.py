@@ -6,8 +6,10 @@ path integration of the same commanded controls is measured in the same run. Tes
 ``maze6`` (unit-square, moderate complexity, medium corridors), traversal seeds 0-3 at full scale: the
 paper's 6 mazes x 4 traversals, 3,000 steps each.
 
-Not built: the paper's offline SLAM and an occupancy-grid particle filter standing in for Cartographer;
-the report says so beside the table.
+A second method, ``mcl``, stands in for Cartographer (C++/ROS, not available here): Monte Carlo
+localisation on the **true** occupancy grid (:mod:`cogmap.inference.grid_mcl`) over the same traversals,
+a privileged reference that needs no map learning. Not built: the paper's offline SLAM; the report says so
+beside the table.
 """
 
 from __future__ import annotations
@@ -30,7 +32,9 @@ SETTINGS = {"full": {"pretrain_maze": 0, "pretrain_steps": 2000, "pretrain_iters
 SETTINGS["reduced"] = SETTINGS["full"]
 CHECKPOINTS = (250, 500, 1000, 1500, 2000, 2500, 3000)
 # paper (Section IV-B, Figure 5a): localisation error at step 3,000 over 24 test traversals, maze units
-PAPER = {"online": (0.03, 0.02), "offline": (0.04, 0.02), "path_integration": (0.14, 0.1)}
+PAPER = {"online": (0.03, 0.02), "offline": (0.04, 0.02), "path_integration": (0.14, 0.1), "cartographer": (0.05, 0.04)}
+METHODS = ("online", "mcl")
+LABEL = {"online": "DVBF-LM online SLAM (ours)", "mcl": "grid MCL on the true map (ours; Cartographer stand-in)"}
 CURVE_EVERY = 10
 
 
@@ -39,9 +43,10 @@ def dvbf_slam_plan(scale: str, seeds=None, methods=None, envs=None) -> dict:
     mazes = s["mazes"] if envs is None else [_maze_seed(e) for e in envs]
     if 0 in mazes:
         raise ValueError(f"{NAME}: maze0 pretrains the emission; test mazes are maze1 and up")
-    methods = ["online"] if methods is None else list(methods)
-    if methods != ["online"]:
-        raise ValueError(f"the {NAME} study has one method, 'online' (path integration is measured in each run); "
+    methods = list(METHODS) if methods is None else list(methods)
+    bad = [m for m in methods if m not in METHODS]
+    if bad or not methods:
+        raise ValueError(f"{NAME} methods are {list(METHODS)} (path integration is measured in each run); "
                          f"got {methods}")
     return {"study": NAME, "scale": scale, "stop_rule": f"{s['steps']} traversal steps", "coverage_level": None,
             "success_rule": None, "aimapp_patience": None, "envs": [f"maze{m}" for m in mazes],
@@ -58,23 +63,28 @@ def _maze_seed(env: str) -> int:
 def dvbf_slam_specs(plan: dict) -> list[dict]:
     from cogmap.dvbf.run import NOISE
     from cogmap.dvbf.slam import SLAMConfig
+    from cogmap.inference.grid_mcl import MCLConfig
 
     from .config import spec_digest
 
     # filter and training settings for the key; the map grid and emission size come from the maze in slam_run
-    config = SLAMConfig(**plan["params"]["overrides"]).to_json()
+    options = {"online": {"slam": SLAMConfig(**plan["params"]["overrides"]).to_json()},
+               "mcl": {"mcl": MCLConfig(rot_std=NOISE.rot_std, trans_frac=NOISE.trans_frac).to_json()}}
     specs = []
     for env in plan["envs"]:
-        for seed in plan["seeds"]:
-            spec = {"study": NAME, "scale": plan["scale"], "env": env, "method": "online", "seed": int(seed),
-                    "noise": {"rot_std": NOISE.rot_std, "trans_frac": NOISE.trans_frac},
-                    "steps": plan["steps"][env], "stop_rule": plan["stop_rule"], "coverage_level": None,
-                    "success_rule": None, "method_options": {"slam": config}, "params": plan["params"]}
-            specs.append({"key": f"{env}__online__s{seed}__{spec_digest(spec)}", **spec})
+        for method in plan["methods"]:
+            for seed in plan["seeds"]:
+                spec = {"study": NAME, "scale": plan["scale"], "env": env, "method": method, "seed": int(seed),
+                        "noise": {"rot_std": NOISE.rot_std, "trans_frac": NOISE.trans_frac},
+                        "steps": plan["steps"][env], "stop_rule": plan["stop_rule"], "coverage_level": None,
+                        "success_rule": None, "method_options": options[method], "params": plan["params"]}
+                specs.append({"key": f"{env}__{method}__s{seed}__{spec_digest(spec)}", **spec})
     return specs
 
 
 def run_dvbf_slam(spec: dict) -> dict:
+    if spec["method"] == "mcl":
+        return _run_mcl(spec)
     from cogmap.dvbf.run import slam_run
 
     p = spec["params"]
@@ -87,14 +97,43 @@ def run_dvbf_slam(spec: dict) -> dict:
     true = np.array([[float(r["true_x"]), float(r["true_y"])] for r in rows])
     err = np.array([float(r["error"]) for r in rows])
     err_pi = np.array([float(r["error_pi"]) for r in rows])
+    return _errors(true, err, err_pi, metrics["seconds"])
+
+
+def _errors(true, err, err_pi, seconds) -> dict:
     # timing fields end in _s (cogmap.study.runs.strip_timings drops them for comparisons)
-    return {"error_final": metrics["error_final"], "error_pi_final": metrics["error_pi_final"],
-            "error_mean": metrics["error_mean"], "error_pi_mean": metrics["error_pi_mean"],
+    path_length = float(np.sum(np.hypot(*np.diff(true, axis=0).T)))
+    return {"error_final": float(err[-1]), "error_pi_final": float(err_pi[-1]),
+            "error_mean": float(err.mean()), "error_pi_mean": float(err_pi.mean()),
             "error_max": float(err.max()), "better_than_pi_share": float(np.mean(err < err_pi)),
-            "path_length": metrics["path_length"], "run_s": metrics["seconds"],
+            "path_length": path_length, "run_s": seconds,
             "curve_every": CURVE_EVERY, "error_curve": np.round(err[::CURVE_EVERY], 5).tolist(),
             "error_pi_curve": np.round(err_pi[::CURVE_EVERY], 5).tolist(),
             "trajectory_digest": hashlib.sha256(np.round(true, 5).tobytes()).hexdigest()[:16]}
+
+
+def _run_mcl(spec: dict) -> dict:
+    """The Cartographer stand-in on the traversal ``slam_run`` would see (same maze, seed and noise)."""
+    import time
+
+    from cogmap.dvbf.run import NOISE
+    from cogmap.dvbf.slam import path_integration
+    from cogmap.envs.maze import make_maze
+    from cogmap.envs.maze_sim import LIDAR_RANGE
+    from cogmap.envs.maze_traversal import traverse
+    from cogmap.inference.grid_mcl import MCLConfig, mcl_localise
+
+    tic = time.perf_counter()
+    maze = make_maze(_maze_seed(spec["env"]))
+    tr = traverse(maze, spec["steps"], seed=spec["seed"], noise=NOISE)
+    cfg = MCLConfig(**{**spec["method_options"]["mcl"], "seed": spec["seed"]})
+    means, _, _ = mcl_localise(maze.occupancy(cfg.resolution), maze.size, tr.poses[0], tr.controls, tr.scans, cfg,
+                               LIDAR_RANGE)
+    pi = path_integration(tr.poses[0], tr.controls)
+    err = np.hypot(*(means[:, :2] - tr.poses[:, :2]).T)
+    err_pi = np.hypot(*(pi[:, :2] - tr.poses[:, :2]).T)
+    # true positions as slam_run's trajectory.csv holds them (6 decimals), so the digests compare across methods
+    return _errors(np.round(tr.poses[:, :2], 6), err, err_pi, time.perf_counter() - tic)
 
 
 def _at(curve, every, step):
@@ -106,50 +145,63 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
     from .report import _csv, _md, _plt
 
     study_dir = Path(study_dir)
-    results = sorted(results, key=lambda r: (_maze_seed(r["spec"]["env"]), r["spec"]["seed"]))
+    results = sorted(results, key=lambda r: (METHODS.index(r["spec"]["method"]), _maze_seed(r["spec"]["env"]),
+                                             r["spec"]["seed"]))
+    by_method = {m: [r for r in results if r["spec"]["method"] == m] for m in METHODS}
     steps = max(plan["steps"].values())
     checks = [c for c in CHECKPOINTS if c < steps] + [steps - 1]
-    header = ["maze", "traversal", "path length", *[f"step {c}" for c in checks[:-1]], f"step {steps} (last)", "mean",
-              "max",
-              "steps better than PI", "run time (s)"]
+    header = ["method", "maze", "traversal", "path length", *[f"step {c}" for c in checks[:-1]],
+              f"step {steps} (last)", "mean", "max", "steps better than PI", "run time (s)"]
     table = []
     for r in results:
         s, x = r["spec"], r["result"]
         e = x["curve_every"]
-        table.append([s["env"], s["seed"], f"{x['path_length']:.1f}",
+        table.append([s["method"], s["env"], s["seed"], f"{x['path_length']:.1f}",
                       *[f"{_at(x['error_curve'], e, c):.3f} / {_at(x['error_pi_curve'], e, c):.3f}"
                         for c in checks[:-1]],
                       f"**{x['error_final']:.3f}** / {x['error_pi_final']:.3f}", f"{x['error_mean']:.3f}",
                       f"{x['error_max']:.3f}", f"{100 * x['better_than_pi_share']:.0f} %", f"{x['run_s']:.0f}"])
     _csv(study_dir / "table.csv", header, table)
-    fin = np.array([r["result"]["error_final"] for r in results])
-    fin_pi = np.array([r["result"]["error_pi_final"] for r in results])
-    n = len(results)
+    # path integration depends only on the traversal: take it from whichever method ran each traversal
+    traversals = {(r["spec"]["env"], r["spec"]["seed"]): r["result"] for r in results}
+    fin_pi = np.array([x["error_pi_final"] for x in traversals.values()])
     summary_header = ["method", f"error at step {steps} (maze units): median", "mean ± std", "runs"]
-    summary = [["DVBF-LM online SLAM (ours)", f"{np.median(fin):.3f}", f"{fin.mean():.3f} ± {fin.std():.3f}", n],
-               ["path integration (ours)", f"{np.median(fin_pi):.3f}", f"{fin_pi.mean():.3f} ± {fin_pi.std():.3f}", n],
-               ["paper: online", "–", "0.03 ± 0.02", 24], ["paper: offline", "–", "0.04 ± 0.02 (not built here)", 24],
-               ["paper: path integration", "–", "0.14 ± 0.1", 24],
-               ["paper: Cartographer", "–", "(not available here; no stand-in built)", "–"]]
-    below = int(np.sum(fin < fin_pi))
-    need = int(np.ceil(20 / 24 * n))
-    med_ok = np.median(fin) <= 2 * PAPER["online"][0]
-    if n == 24:
-        verdict = "met" if below >= 20 else "not met"
+    summary = []
+    for m in METHODS:
+        fin = np.array([r["result"]["error_final"] for r in by_method[m]])
+        summary.append([LABEL[m], f"{np.median(fin):.3f}", f"{fin.mean():.3f} ± {fin.std():.3f}", len(fin)] if len(fin)
+                       else [LABEL[m], "–", "(not run in this study directory)", 0])
+    summary += [["path integration (ours)", f"{np.median(fin_pi):.3f}", f"{fin_pi.mean():.3f} ± {fin_pi.std():.3f}",
+                 len(fin_pi)],
+                ["paper: online", "–", "0.03 ± 0.02", 24], ["paper: offline", "–", "0.04 ± 0.02 (not built here)", 24],
+                ["paper: path integration", "–", "0.14 ± 0.1", 24],
+                ["paper: Cartographer (tuned)", "–", "0.05 ± 0.04", 24]]
+    online = by_method["online"]
+    if online:
+        fin = np.array([r["result"]["error_final"] for r in online])
+        pis = np.array([r["result"]["error_pi_final"] for r in online])
+        n, below = len(online), int(np.sum(fin < pis))
+        need = int(np.ceil(20 / 24 * n))
+        med_ok = np.median(fin) <= 2 * PAPER["online"][0]
+        verdict = ("met" if below >= 20 else "not met") if n == 24 else \
+            f"{need} of {n} needed at that rate: " + ("met" if below >= need else "not met")
+        target = (f"**Target:** online below path integration at step {steps} in >= 20 of 24 traversals: {below} of "
+                  f"{n} ({verdict}); median within 2x of the paper's 0.03: {np.median(fin):.3f} "
+                  f"({'met' if med_ok else 'not met'}).")
     else:
-        verdict = f"{need} of {n} needed at that rate: " + ("met" if below >= need else "not met")
-    target = (f"**Target:** online below path integration at step {steps} in >= 20 of 24 traversals: {below} of {n} "
-              f"({verdict}); median within 2x of the paper's 0.03: {np.median(fin):.3f} "
-              f"({'met' if med_ok else 'not met'}).")
+        target = "**Target** (online SLAM below path integration): no online runs in this study directory."
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 4))
-    for key, label, c in (("error_curve", "DVBF-LM online SLAM", "tab:blue"),
-                          ("error_pi_curve", "path integration", "tab:red")):
-        curves = np.array([r["result"][key] for r in results])
+    series = [([r["result"] for r in by_method[m]], "error_curve", LABEL[m].split(" (")[0], c)
+              for m, c in (("online", "tab:blue"), ("mcl", "tab:green")) if by_method[m]]
+    series.append((list(traversals.values()), "error_pi_curve", "path integration", "tab:red"))
+    for runs, key, label, c in series:
+        curves = np.array([x[key] for x in runs])
         t = np.arange(curves.shape[1]) * CURVE_EVERY
-        ax.plot(t, np.median(curves, 0), c=c, label=f"{label} (median over {n})")
+        ax.plot(t, np.median(curves, 0), c=c, label=f"{label} (median over {len(curves)})")
         ax.fill_between(t, *np.percentile(curves, [25, 75], 0), color=c, alpha=0.2)
-    for key, c, label in (("online", "tab:blue", "paper online"), ("path_integration", "tab:red", "paper PI")):
+    for key, c, label in (("online", "tab:blue", "paper online"), ("path_integration", "tab:red", "paper PI"),
+                          ("cartographer", "tab:green", "paper Cartographer")):
         m, sd = PAPER[key]
         ax.errorbar([steps * 1.02], [m], yerr=[sd], fmt="s", c=c, mfc="white", capsize=3, label=f"{label} at 3000")
     ax.set_xlabel("step")
@@ -158,15 +210,24 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
     fig.tight_layout()
     fig.savefig(study_dir / "error.png", dpi=100)
     plt.close(fig)
-    spec0 = results[0]["spec"]
-    noise = spec0["noise"]
-    note = ("Each cell: DVBF-LM online SLAM / path integration, localisation error (distance of the particle mean "
-            "to the true position) in units of the maze side (1). Emission pretrained with known poses on a "
-            f"{plan['params']['pretrain_steps']}-step traversal of maze 0 ({plan['params']['pretrain_iters']} Adam "
-            f"steps) and frozen, then {spec0['method_options']['slam']['n_particles']} particles and online q(M) "
-            f"learning (`cogmap dvbf slam` defaults); actuation noise turn std {noise['rot_std']:g} rad, forward "
-            f"{100 * noise['trans_frac']:g} %. The shaded bands in error.png are the 25-75 % range over runs. "
-            "The paper's traversals come from human operators, ours from the seeded operator "
-            "(`cogmap.envs.maze_traversal`). Offline SLAM and a Cartographer stand-in are not built.")
-    return (_md(summary_header, summary) + "\n\n" + target + "\n\n" + _md(header, table) + "\n\n" + note
+    noise = results[0]["spec"]["noise"]
+    parts = ["Each cell: the method / path integration, localisation error (distance of the particle mean to the "
+             "true position) in units of the maze side (1); both methods filter the same seeded traversals "
+             "(the trajectory digests agree). "
+             f"Actuation noise turn std {noise['rot_std']:g} rad, forward {100 * noise['trans_frac']:g} %."]
+    if online:
+        parts.append(f"online: emission pretrained with known poses on a {plan['params']['pretrain_steps']}-step "
+                     f"traversal of maze 0 ({plan['params']['pretrain_iters']} Adam steps) and frozen, then "
+                     f"{online[0]['spec']['method_options']['slam']['n_particles']} particles and online q(M) "
+                     "learning (`cogmap dvbf slam` defaults).")
+    if by_method["mcl"]:
+        m = by_method["mcl"][0]["spec"]["method_options"]["mcl"]
+        parts.append(f"mcl: Monte Carlo localisation with {m['n_particles']} particles on the true walls rasterised at "
+                     f"{m['resolution']} x {m['resolution']}, beam model (ray marching, range std {m['sigma']:g}, "
+                     f"uniform floor {m['floor']:g}), transition = the simulator's actuation noise. It is given the "
+                     "true map, which Cartographer has to build, so it is a privileged reference, not Cartographer.")
+    parts.append("The shaded bands in error.png are the 25-75 % range over runs. The paper's traversals come from "
+                 "human operators, ours from the seeded operator (`cogmap.envs.maze_traversal`). Offline SLAM is not "
+                 "built.")
+    return (_md(summary_header, summary) + "\n\n" + target + "\n\n" + _md(header, table) + "\n\n" + " ".join(parts)
             + "\n\n![localisation error over steps](error.png)\n")

@@ -10,7 +10,8 @@ from cogmap.study.runner import load_runs
 
 def test_full_plan_is_six_mazes_by_four_traversals_with_distinct_keys():
     specs = run_specs(study_plan("dvbf-slam", "full"))
-    assert len(specs) == 24 and len({s["key"] for s in specs}) == 24
+    assert len(specs) == 48 and len({s["key"] for s in specs}) == 48
+    assert {s["method"] for s in specs} == {"online", "mcl"}
     assert {s["env"] for s in specs} == {f"maze{m}" for m in range(1, 7)}
     assert all(s["steps"] == 3000 and s["params"]["pretrain_maze"] == 0 for s in specs)
 
@@ -20,21 +21,28 @@ def test_bad_input_is_refused():
         study_plan("dvbf-slam", "tiny", envs=["maze0"])
     with pytest.raises(ValueError, match="maze<seed>"):
         study_plan("dvbf-slam", "tiny", envs=["house"])
-    with pytest.raises(ValueError, match="one method"):
+    with pytest.raises(ValueError, match="methods are"):
         study_plan("dvbf-slam", "tiny", methods=["offline"])
 
 
 def test_tiny_study_runs_resumes_and_reports(tmp_path):
     first = run_study("dvbf-slam", tmp_path, scale="tiny", progress=False)
-    assert first["complete"] and first["runs"] == 1
+    assert first["complete"] and first["runs"] == 2  # online and the grid-MCL stand-in on one traversal
     stored = load_runs(tmp_path / "dvbf-slam")
-    assert run_study("dvbf-slam", tmp_path, scale="tiny", progress=False)["runs"] == 1
+    assert run_study("dvbf-slam", tmp_path, scale="tiny", progress=False)["runs"] == 2
     assert load_runs(tmp_path / "dvbf-slam") == stored  # nothing redone
-    (result,) = [r["result"] for r in stored.values()]
-    curve = np.array(result["error_curve"])
-    assert curve.shape == (3,) and curve[0] < 1e-2  # every 10th of 30 steps; the start is known
-    assert result["error_final"] <= result["error_max"] and result["error_mean"] <= result["error_max"]
-    assert 0 <= result["better_than_pi_share"] <= 1
+    by_method = {r["spec"]["method"]: r["result"] for r in stored.values()}
+    assert set(by_method) == {"online", "mcl"}
+    # the same traversal (same maze, seed and noise), so the same path integration
+    assert by_method["online"]["trajectory_digest"] == by_method["mcl"]["trajectory_digest"]
+    assert by_method["online"]["error_pi_final"] == pytest.approx(by_method["mcl"]["error_pi_final"], abs=1e-5)
+    for result in by_method.values():
+        curve = np.array(result["error_curve"])
+        assert curve.shape == (3,) and curve[0] < 1e-2  # every 10th of 30 steps; the start is known
+        assert result["error_final"] <= result["error_max"] and result["error_mean"] <= result["error_max"]
+        assert 0 <= result["better_than_pi_share"] <= 1
+    assert by_method["mcl"]["error_max"] < 0.01  # the true map keeps it on track over 30 steps
     table = (tmp_path / "dvbf-slam" / "table.md").read_text()
     assert "paper: online" in table and "0.03 ± 0.02" in table and "**Target:**" in table
+    assert "Cartographer stand-in" in table and "0.05 ± 0.04" in table
     assert (tmp_path / "dvbf-slam" / "error.png").is_file()
