@@ -13,6 +13,23 @@
   (known free, next to unknown) and re-plans when it arrives, every ``replan_every`` steps or when a
   wall stops it; with no frontier left it walks randomly.
 
+Four choices of ours keep the ``mi`` agent moving (measured on moderate-small, seed 0, 300 steps: it
+covered 0.083 of the tiles on a path of 0.26 before them, 0.500 on a path of 2.34 after, the random
+walk 0.278 on 2.70):
+
+* a predicted collision is a rise of the obstacle penalty above its value at the start
+  (:func:`~cogmap.planning.mi_exploration.truncate_at_collision`): beside a wall, or in a corridor a few
+  histogram cells wide, the penalty at the start is already high and an absolute level cut every
+  candidate at its first step, so the agent stood for good;
+* the current scan also cuts candidates where they would meet a wall it shows
+  (:func:`~cogmap.planning.mi_exploration.scan_free_steps`), which the penalty cannot see right after a
+  bump, when the agent stands on its peak;
+* the MI argmax runs over the candidates with the longest free prefix (``MIConfig.feasible_only``):
+  standing still, as a cut candidate does, scores a high ``I(x_1:T; M)`` (repeated scans of one place,
+  no pose diffusion) without exploring;
+* candidates move at full speed and only their turns are optimised (``MIConfig.steer_only``), and after a
+  bump the agent re-plans at once instead of standing until the next filter chunk.
+
 All three move with the same control bounds (turn at most 0.35 rad, step at most 0.01 per time step,
 actuation noise of ``cogmap dvbf slam``) from the same seeded start. The exploration ratio is measured
 on the true positions over the Table II tiles (:func:`cogmap.envs.maze.exploration_ratio`); the
@@ -110,8 +127,8 @@ class ExploreConfig:
 
 
 #: planning settings of the study (much lighter than the paper's F = 40, L = 30, M = 40, K = 100)
-STUDY_MI = MIConfig(horizon=50, n_candidates=6, n_marginal=24, n_maps=6, n_per_map=12, opt_iters=60,
-                    obs_every=10, dim=4, pose_samples=2)
+STUDY_MI = MIConfig(horizon=50, n_candidates=12, n_marginal=24, n_maps=6, n_per_map=12, opt_iters=150,
+                    obs_every=10, dim=4, pose_samples=2, steer_only=True)
 
 
 @dataclass
@@ -385,9 +402,12 @@ class MIPlanner:
     def plan(self, slam, rng: np.random.Generator) -> tuple[np.ndarray, dict]:
         """Best candidate control sequence by the mutual information ``I(x_1:T; M)`` (Section VI).
 
-        The obstacle penalty grid is built from 400 poses drawn among the SLAM's estimates so far;
-        candidates start from the current particles, are truncated at their predicted collision and
-        scored by :func:`cogmap.planning.mi_exploration.score_candidates`.
+        The obstacle penalty grid is built from 400 poses drawn among the SLAM's estimates so far (their
+        observed scans, or the map mean's scans there with ``"predicted"``); candidates start from the current
+        particles and are truncated at their predicted collision (in the penalty and, with
+        ``MIConfig.scan_margin``, in the current scan); the ones with the longest free prefix (all of them
+        with ``MIConfig.feasible_only`` off) are scored by
+        :func:`cogmap.planning.mi_exploration.score_candidates`.
 
         Parameters
         ----------
@@ -412,6 +432,7 @@ class MIPlanner:
             beam_endpoints,
             candidate_controls,
             obstacle_penalty_grid,
+            scan_free_steps,
             score_candidates,
             truncate_at_collision,
         )
@@ -429,8 +450,21 @@ class MIPlanner:
         self.key, k_c, k_s = jax.random.split(self.key, 3)
         starts = slam.particles
         cand = candidate_controls(k_c, starts, grid, self.extent, self.mi, sigma_t=self.model.sigma_t)
-        controls, free = truncate_at_collision(cand.controls, slam.estimate, grid, self.extent)
-        scores = score_candidates(k_s, q, slam.params.emission, self.model, starts, controls, self.mi)
+        controls, free = truncate_at_collision(cand.controls, slam.estimate, grid, self.extent,
+                                              self.mi.collision_level)
+        if self.mi.scan_margin is not None:  # also stop where the current scan shows a wall
+            seen = scan_free_steps(controls, slam.estimate, slam.scans[t], self.model.lidar_range,
+                                   self.mi.scan_margin)
+            free = np.minimum(free, seen)
+            for f, k in enumerate(free):
+                controls[f, k:, 1] = 0.0
+        # the argmax runs over the candidates the obstacle optimisation made safe (no predicted collision, else
+        # the longest free prefix): a cut candidate stands at its wall, and standing still scores a high
+        # I(x_1:T; M) (repeated scans of one place, no pose diffusion) without exploring anything
+        feasible = free == free.max() if self.mi.feasible_only else np.ones(len(free), bool)
+        scores = np.full(len(free), -np.inf)
+        scores[feasible] = score_candidates(k_s, q, slam.params.emission, self.model, starts, controls[feasible],
+                                            self.mi)
         best = int(np.argmax(scores))
         return controls[best], {"scores": scores, "best": best, "penalty": cand.penalty, "grid": grid,
                                 "controls": controls, "free_steps": free, "starts": np.asarray(starts)}
@@ -594,8 +628,8 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
                 # (the distance moved before the wall is not known to it)
                 slam.advance(np.array([u[0], 0.0 if blocked else u[1]])[None], scan[None])
             if blocked and planner is not None:
-                # the plan ran into a wall: stand (turning as planned) until the next filter chunk, then re-plan
-                queue = [np.array([v[0], 0.0]) for v in queue[: (-t) % cfg.train_every]]
+                # the plan ran into a wall: re-plan from here at once (the filter takes the shorter chunk)
+                queue = []
             if t % cfg.curve_every == 0 or t == steps - 1:
                 ratio_curve.append((t, len(tiles) / maze.tiles**2))
                 if slam is not None and slam.t == t and t % (10 * cfg.curve_every) == 0:

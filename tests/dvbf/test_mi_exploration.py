@@ -15,6 +15,7 @@ from cogmap.planning.mi_exploration import (
     penalty_at,
     projected_mutual_information,
     rollout,
+    scan_free_steps,
     score_candidates,
     squash_controls,
     truncate_at_collision,
@@ -109,3 +110,33 @@ def test_candidates_are_cut_at_their_first_predicted_collision():
     assert free[0] == 19 and free[1] == 40
     assert np.all(cut[0, free[0]:, 1] == 0) and np.all(cut[0, :free[0], 1] == 0.01)
     assert np.array_equal(cut[1], north) and np.array_equal(cut[:, :, 0], np.stack([east, north])[:, :, 0])
+
+
+def test_a_start_beside_a_wall_does_not_cut_every_candidate():
+    # end points at x = 0.5 fill the histogram column [0.5, 0.52) (centre 0.51); the agent stands at
+    # x = 0.495, a quarter of the way up that column's bilinear ramp (0.49 to 0.51), where the penalty is above
+    # the level: walking away or along the wall is free, walking into it is cut
+    wall = np.stack([np.full(200, 0.5), np.linspace(0, 1, 200)], 1)
+    grid = obstacle_penalty_grid(wall, 200, 1.0, 50)
+    start = np.array([0.495, 0.5, 0.0])
+    assert float(penalty_at(grid, jnp.asarray(start[None, :2]), 1.0)[0]) > 0.5
+    west = np.tile([[0.0, 0.01]], (20, 1))
+    west[0, 0] = np.pi
+    north = np.tile([[0.0, 0.01]], (20, 1))
+    north[0, 0] = np.pi / 2
+    east = np.tile([[0.0, 0.01]], (20, 1))
+    _, free = truncate_at_collision(np.stack([west, north, east]), start, grid, 1.0)
+    assert free[0] == 20 and free[1] == 20 and free[2] < 3
+
+
+def test_candidates_stop_before_a_wall_the_current_scan_shows():
+    # 4 beams from heading 0: a wall 0.1 ahead (east), nothing within range elsewhere
+    scan = np.array([0.1, 0.53, 0.53, 0.53])
+    east = np.tile([[0.0, 0.01]], (20, 1))
+    north_west = east.copy()
+    north_west[0, 0] = 3 * np.pi / 4  # between beams 1 and 2, both without a return
+    free = scan_free_steps(np.stack([east, north_west]), np.array([0.5, 0.5, 0.0]), scan, 0.53, margin=0.01)
+    # step k ends 0.01 (k + 1) east; blocked once 0.01 (k + 1) + 0.01 > 0.1, i.e. from k = 9 on
+    assert free.tolist() == [9, 20]
+    with pytest.raises(ValueError, match="scan_margin"):
+        MIConfig(scan_margin=-1.0)
