@@ -24,7 +24,10 @@ uncertainty shows.
 
 Defaults are the paper's (Appendix D-B): horizon ``T = 50``, ``F = 40`` candidates, ``L = 30``,
 ``M = 40``, ``K = 100``; Appendix E-A optimises for 500 Adam steps at learning rate 1e-3 (on its own
-control scale). Smaller values are arguments. Pure functions of arrays (jax for the model parts,
+control scale). Smaller values are arguments. Our additions to the procedure (:class:`MIConfig`:
+``collision_level``, ``steer_only``, ``feasible_only``, ``scan_margin``; :func:`truncate_at_collision`,
+:func:`scan_free_steps`) keep the agent moving in narrow corridors; ``feasible_only`` and the scan check
+are on by default, ``steer_only`` is off (the study turns it on). Pure functions of arrays (jax for the model parts,
 numpy for the estimator); nothing here imports the agent layer.
 """
 
