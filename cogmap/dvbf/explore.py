@@ -13,7 +13,7 @@
   (known free, next to unknown) and re-plans when it arrives, every ``replan_every`` steps or when a
   wall stops it; with no frontier left it walks randomly.
 
-Four choices of ours keep the ``mi`` agent moving (measured on moderate-small, seed 0, 300 steps: it
+Five choices of ours keep the ``mi`` agent moving (measured on moderate-small, seed 0, 300 steps: it
 covered 0.083 of the tiles on a path of 0.26 before them, 0.500 on a path of 2.34 after, the random
 walk 0.278 on 2.70):
 
@@ -27,8 +27,9 @@ walk 0.278 on 2.70):
 * the MI argmax runs over the candidates with the longest free prefix (``MIConfig.feasible_only``):
   standing still, as a cut candidate does, scores a high ``I(x_1:T; M)`` (repeated scans of one place,
   no pose diffusion) without exploring;
-* candidates move at full speed and only their turns are optimised (``MIConfig.steer_only``), and after a
-  bump the agent re-plans at once instead of standing until the next filter chunk.
+* candidates move at full speed and only their turns are optimised (``MIConfig.steer_only``, on in
+  :data:`STUDY_MI`): otherwise the optimiser also avoids walls by slowing down, and slow candidates win;
+* after a bump the agent re-plans at once instead of standing until the next filter chunk.
 
 All three move with the same control bounds (turn at most 0.35 rad, step at most 0.01 per time step,
 actuation noise of ``cogmap dvbf slam``) from the same seeded start. The exploration ratio is measured
