@@ -11,7 +11,8 @@
   **true** poses (a privileged baseline: no localisation error), cells of a quarter corridor width;
   it walks the shortest 4-connected path through known-free cells to the nearest frontier cell
   (known free, next to unknown) and re-plans when it arrives, every ``replan_every`` steps or when a
-  wall stops it; with no frontier left it walks randomly.
+  wall stops it (marking the cell ahead occupied first, so the new path goes around the wall); with no
+  frontier left it walks randomly.
 
 Five choices of ours keep the ``mi`` agent moving (measured on moderate-small, seed 0, 300 steps: it
 covered 0.083 of the tiles on a path of 0.26 before them, 0.500 on a path of 2.34 after, the random
@@ -333,6 +334,10 @@ class Frontier:
             ``(turn in rad, forward in maze units)``.
         """
         self.update(pose, scan)
+        if blocked:  # the bump says a wall is right ahead: mark it, so the re-plan goes around it
+            i, j = self._cell(pose[:2] + 0.75 * self.res * np.array([np.cos(pose[2]), np.sin(pose[2])]))
+            if (i, j) != tuple(self._cell(pose[:2])):
+                self.grid[i, j] = 2
         self.since += 1
         if blocked or not self.path or self.since >= self.cfg.replan_every:
             self.path = self._plan(pose)
