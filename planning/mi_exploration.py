@@ -221,6 +221,28 @@ def _optimise_impl(raw, z0, eps, grid, sig, extent, cfg):
     return r, before, _penalty_loss(r, z0, eps, grid, sig, extent, cfg)[1]
 
 
+def mean_paths(controls, start) -> np.ndarray:
+    """Mean poses ``(F, T + 1, 3)`` of candidates ``(F, T, 2)`` rolled out from ``start (3,)``."""
+    return np.asarray(jax.vmap(lambda c: rollout(jnp.asarray(start, float), c))(jnp.asarray(controls, float)))
+
+
+def cut_forward(controls, free) -> np.ndarray:
+    """A copy of ``controls (F, T, 2)`` whose forward steps are 0 from step ``free[f]`` of candidate ``f`` on
+    (the agent stands and only turns)."""
+    u = np.array(controls, float)
+    u[np.arange(u.shape[1])[None, :] >= np.asarray(free)[:, None], 1] = 0.0
+    return u
+
+
+def penalty_free_steps(paths, grid, extent: float, level: float = 0.5) -> np.ndarray:
+    """Steps ``(F,)`` before each mean path ``(F, T + 1, 3)`` (its first pose the start) reads an obstacle
+    penalty more than ``level`` above the penalty at its start; ``T`` where it never does."""
+    grid = jnp.asarray(grid, float)
+    pen0 = np.asarray(penalty_at(grid, jnp.asarray(paths[:, :1, :2]), extent))  # (F, 1)
+    hit = np.asarray(penalty_at(grid, jnp.asarray(paths[:, 1:, :2]), extent)) > pen0 + level
+    return np.where(hit.any(1), hit.argmax(1), paths.shape[1] - 1)
+
+
 def truncate_at_collision(controls, start, grid, extent: float, level: float = 0.5):
     """Cut every candidate ``(F, T, 2)`` at its first predicted collision: from the first step whose mean
     pose (rolled out from ``start (3,)``) reads an obstacle penalty more than ``level`` above the penalty
@@ -232,30 +254,22 @@ def truncate_at_collision(controls, start, grid, extent: float, level: float = 0
     relative to the start because the agent stands where it stands: in a corridor narrower than a few
     histogram cells, or beside a wall, the penalty at the start is already above ``level``, and an
     absolute threshold would cut every candidate at its first step and leave the agent standing for good."""
-    u = np.array(controls, float)
-    paths = np.asarray(jax.vmap(lambda c: rollout(jnp.asarray(start, float), c))(jnp.asarray(u)))
-    grid = jnp.asarray(grid, float)
-    pen0 = float(penalty_at(grid, jnp.asarray(start, float)[None, :2], extent)[0])
-    pen = np.asarray(penalty_at(grid, jnp.asarray(paths[:, 1:, :2]), extent))
-    hit = pen > pen0 + level
-    free = np.where(hit.any(1), hit.argmax(1), u.shape[1])
-    for f, n in enumerate(free):
-        u[f, n:, 1] = 0.0
-    return u, free
+    free = penalty_free_steps(mean_paths(controls, start), grid, extent, level)
+    return cut_forward(controls, free), free
 
 
-def scan_free_steps(controls, pose, scan, lidar_range: float, margin: float, hit_fraction: float = 0.97):
-    """Steps ``(F,)`` each candidate ``(F, T, 2)``, rolled out from ``pose (3,)``, stays inside the free
-    region the current ``scan (B,)`` shows: a path point at bearing ``b`` and distance ``d`` from the pose
-    counts as blocked when one of the two beams around ``b`` returned from a wall (range below
+def scan_free_steps(paths, scan, lidar_range: float, margin: float, hit_fraction: float = 0.97) -> np.ndarray:
+    """Steps ``(F,)`` each mean path ``(F, T + 1, 3)`` (its first pose the current pose) stays inside the
+    free region the current ``scan (B,)`` shows: a path point at bearing ``b`` and distance ``d`` from the
+    pose counts as blocked when one of the two beams around ``b`` returned from a wall (range below
     ``hit_fraction * lidar_range``) closer than ``d + margin``. Beams that returned nothing bound nothing.
 
     Our addition: right after a bump the agent stands at a wall, where the obstacle penalty already peaks
     and :func:`truncate_at_collision` (a rise above the start) cannot see it; the scan still can."""
     scan = np.asarray(scan, float)
     n = scan.size
-    paths = np.asarray(jax.vmap(lambda c: rollout(jnp.asarray(pose, float), c))(jnp.asarray(controls, float)))
-    rel = paths[:, 1:, :2] - np.asarray(pose, float)[:2]
+    pose = paths[0, 0]
+    rel = paths[:, 1:, :2] - pose[:2]
     d = np.hypot(rel[..., 0], rel[..., 1])
     beam = (np.arctan2(rel[..., 1], rel[..., 0]) - pose[2]) % (2 * np.pi) / (2 * np.pi / n)
     lo = np.floor(beam).astype(int) % n

@@ -437,10 +437,12 @@ class MIPlanner:
         from cogmap.planning.mi_exploration import (
             beam_endpoints,
             candidate_controls,
+            cut_forward,
+            mean_paths,
             obstacle_penalty_grid,
+            penalty_free_steps,
             scan_free_steps,
             score_candidates,
-            truncate_at_collision,
         )
 
         t = slam.t
@@ -456,14 +458,13 @@ class MIPlanner:
         self.key, k_c, k_s = jax.random.split(self.key, 3)
         starts = slam.particles
         cand = candidate_controls(k_c, starts, grid, self.extent, self.mi, sigma_t=self.model.sigma_t)
-        controls, free = truncate_at_collision(cand.controls, slam.estimate, grid, self.extent,
-                                              self.mi.collision_level)
+        # one rollout of the candidates' mean paths serves both collision checks
+        paths = mean_paths(cand.controls, slam.estimate)
+        free = penalty_free_steps(paths, grid, self.extent, self.mi.collision_level)
         if self.mi.scan_margin is not None:  # also stop where the current scan shows a wall
-            seen = scan_free_steps(controls, slam.estimate, slam.scans[t], self.model.lidar_range,
-                                   self.mi.scan_margin)
-            free = np.minimum(free, seen)
-            for f, k in enumerate(free):
-                controls[f, k:, 1] = 0.0
+            free = np.minimum(free, scan_free_steps(paths, slam.scans[t], self.model.lidar_range,
+                                                    self.mi.scan_margin))
+        controls = cut_forward(cand.controls, free)
         # the argmax runs over the candidates the obstacle optimisation made safe (no predicted collision, else
         # the longest free prefix): a cut candidate stands at its wall, and standing still scores a high
         # I(x_1:T; M) (repeated scans of one place, no pose diffusion) without exploring anything

@@ -90,6 +90,13 @@ def load_params(out: Path):
     return eqx.combine(arr, static), cfg
 
 
+def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium"):
+    """The maze and the seeded operator traversal (with the actuation noise :data:`NOISE`) that a SLAM run
+    of ``slam_run(maze_seed, steps, seed=seed)`` filters; other localisers compared on it call this too."""
+    maze = make_maze(maze_seed, complexity, corridor)
+    return maze, traverse(maze, steps, seed=seed, noise=NOISE)
+
+
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
              complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
              pretrain_steps: int = 2000, pretrain_iters: int = 1500, **overrides) -> dict:
@@ -141,8 +148,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    maze = make_maze(maze_seed, complexity, corridor)
-    tr = traverse(maze, steps, seed=seed, noise=NOISE)
+    maze, tr = slam_traversal(maze_seed, steps, seed, complexity, corridor)
     model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64,
                        sigma_t=(0.0005, 0.0005, NOISE.rot_std))
     emission = None

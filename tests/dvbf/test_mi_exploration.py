@@ -11,6 +11,7 @@ from cogmap.planning.mi_exploration import (
     MIConfig,
     beam_endpoints,
     candidate_controls,
+    mean_paths,
     obstacle_penalty_grid,
     penalty_at,
     projected_mutual_information,
@@ -135,7 +136,8 @@ def test_candidates_stop_before_a_wall_the_current_scan_shows():
     east = np.tile([[0.0, 0.01]], (20, 1))
     north_west = east.copy()
     north_west[0, 0] = 3 * np.pi / 4  # between beams 1 and 2, both without a return
-    free = scan_free_steps(np.stack([east, north_west]), np.array([0.5, 0.5, 0.0]), scan, 0.53, margin=0.015)
+    paths = mean_paths(np.stack([east, north_west]), np.array([0.5, 0.5, 0.0]))
+    free = scan_free_steps(paths, scan, 0.53, margin=0.015)
     # step k ends 0.01 (k + 1) east; blocked once 0.01 (k + 1) + 0.015 > 0.1, i.e. from k = 8 on
     assert free.tolist() == [8, 20]
     with pytest.raises(ValueError, match="scan_margin"):
