@@ -92,7 +92,26 @@ def load_params(out: Path):
 
 def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium"):
     """The maze and the seeded operator traversal (with the actuation noise :data:`NOISE`) that a SLAM run
-    of ``slam_run(maze_seed, steps, seed=seed)`` filters; other localisers compared on it call this too."""
+    of ``slam_run(maze_seed, steps, seed=seed)`` filters; other localisers compared on it call this too.
+
+    Parameters
+    ----------
+    maze_seed : int
+        Seed of the maze.
+    steps : int
+        Time steps of the traversal (the start counts as step 0).
+    seed : int
+        Seed of the traversal.
+    complexity, corridor : str
+        Maze family (Table II).
+
+    Returns
+    -------
+    maze : Maze
+        The maze.
+    traversal : Traversal
+        True poses, commanded controls, scans and blocked flags.
+    """
     maze = make_maze(maze_seed, complexity, corridor)
     return maze, traverse(maze, steps, seed=seed, noise=NOISE)
 
