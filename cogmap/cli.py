@@ -218,7 +218,9 @@ def build_parser() -> argparse.ArgumentParser:
     dx.add_argument("--corridor", default="small", choices=("small", "medium", "large"))
     dx.add_argument("--steps", type=positive_int, default=None,
                     help="steps per method (default: the Table II budget of the maze)")
-    dx.add_argument("--methods", nargs="+", default=["mi", "random", "frontier"], choices=("mi", "random", "frontier"))
+    dx.add_argument("--methods", nargs="+", default=["mi", "random", "frontier"],
+                    choices=("mi", "mi-pull", "random", "frontier"),
+                    help="mi: the paper's agent; mi-pull: with the frontier pull (ours); default: mi random frontier")
     dx.add_argument("--seed", type=int, default=0, help="start, noise and agent seed (default: 0)")
     dx.add_argument("--out", default="runs/dvbf-explore", help="run directory (default: runs/dvbf-explore)")
     dx.add_argument("--quiet", action="store_true")

@@ -64,8 +64,12 @@ class MIConfig:
     walls by slowing down, and slow candidates win the MI score); ``feasible_only``: the argmax of the MI
     runs over the candidates with the longest collision-free prefix only (a candidate cut at a wall stands
     there, and standing still scores high); ``scan_margin``: also cut candidates where they come within this
-    distance of a wall in the current scan (:func:`scan_free_steps`; None: off). ``steer_only``,
-    ``feasible_only``, ``scan_margin`` and the cut at collisions are our additions to the paper's procedure
+    distance of a wall in the current scan (:func:`scan_free_steps`; None: off); ``pull_below``: when the best
+    candidate's score is below this many nats, follow the way to the nearest frontier of the agent's own
+    sensed grid instead (:mod:`.frontier_pull`; None: off, the paper's procedure), on a grid of ``pull_cell``
+    cells where ``pull_hit_min`` returns make a wall and ``pull_min_crossed`` beams make a cell known.
+    ``steer_only``, ``feasible_only``, ``scan_margin``, ``pull_below`` and the cut at collisions are our
+    additions to the paper's procedure
     (:mod:`cogmap.dvbf.explore` says why)."""
 
     horizon: int = 50
@@ -87,6 +91,10 @@ class MIConfig:
     steer_only: bool = False
     feasible_only: bool = True
     scan_margin: float | None = 0.01
+    pull_below: float | None = None
+    pull_cell: float = 0.01
+    pull_hit_min: int = 2
+    pull_min_crossed: int = 3
 
     def __post_init__(self):
         if min(self.horizon, self.n_candidates, self.n_maps, self.pose_samples, self.obs_every, self.dim) < 1:
@@ -97,6 +105,9 @@ class MIConfig:
             raise ValueError(f"MIConfig: scan_margin must be >= 0 or None, got {self.scan_margin}")
         if self.opt_iters < 0 or self.max_step <= 0 or self.max_turn <= 0 or self.hist_cell <= 0:
             raise ValueError(f"MIConfig: bad optimisation or control bounds in {self}")
+        if self.pull_cell <= 0 or self.pull_hit_min < 1 or self.pull_min_crossed < 1:
+            raise ValueError(f"MIConfig: pull_cell must be > 0, pull_hit_min and pull_min_crossed >= 1; got "
+                             f"{self.pull_cell}, {self.pull_hit_min}, {self.pull_min_crossed}")
 
 
 # -- obstacle penalty (Appendix E) ---------------------------------------------------------------

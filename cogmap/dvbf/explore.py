@@ -123,14 +123,53 @@ class ExploreConfig:
         Returns
         -------
         dict
-            Field name -> value.
+            Field name -> value. The frontier pull's settings are left out while it is off
+        (``mi.pull_below`` None): they do nothing then, and study keys made before it existed stay valid.
         """
-        return asdict(self)
+        out = asdict(self)
+        if self.mi.pull_below is None:
+            for k in ("pull_below", "pull_cell", "pull_hit_min", "pull_min_crossed"):
+                out["mi"].pop(k)
+        return out
 
 
 #: planning settings of the study (much lighter than the paper's F = 40, L = 30, M = 40, K = 100)
 STUDY_MI = MIConfig(horizon=50, n_candidates=12, n_marginal=24, n_maps=6, n_per_map=12, opt_iters=150,
                     obs_every=10, dim=4, pose_samples=2, steer_only=True)
+#: ``MIConfig.pull_below`` of the agent with the frontier pull (method ``mi-pull``), nats of the study's estimator
+PULL_BELOW = 1.0
+#: every method a run can name: the DVBF-LM agent as the paper runs it, with the frontier pull, and the baselines
+RUN_METHODS = ("mi", "mi-pull", "random", "frontier")
+
+
+def method_config(method: str, **fields) -> ExploreConfig:
+    """The :class:`ExploreConfig` of a run method: ``"mi-pull"`` is the ``mi`` agent with ``mi.pull_below =``
+    :data:`PULL_BELOW` (on top of ``fields["mi"]``, default :data:`STUDY_MI`); the others name their method.
+
+    Parameters
+    ----------
+    method : str
+        One of :data:`RUN_METHODS`.
+    **fields
+        Other :class:`ExploreConfig` fields.
+
+    Returns
+    -------
+    ExploreConfig
+
+    Raises
+    ------
+    ValueError
+        For an unknown method.
+    """
+    import dataclasses
+
+    if method not in RUN_METHODS:
+        raise ValueError(f"method must be one of {RUN_METHODS}, got {method!r}")
+    if method != "mi-pull":
+        return ExploreConfig(method=method, **fields)
+    mi = dataclasses.replace(fields.pop("mi", STUDY_MI), pull_below=PULL_BELOW)
+    return ExploreConfig(method="mi", mi=mi, **fields)
 
 
 @dataclass
@@ -155,6 +194,8 @@ class ExploreResult:
         Wall-clock seconds of each planning call.
     blocked : int
         Steps on which a wall stopped the robot.
+    pulled : int
+        Planning calls that followed the frontier pull (``MIConfig.pull_below``).
     params : DVBFParams or None
         q(M) and emission at the end (``mi`` or ``learn_map``).
     model : DVBFConfig or None
@@ -171,6 +212,7 @@ class ExploreResult:
     info_curve: list  # [(step, KL(q(M) || p(M)))]
     plan_seconds: list  # wall clock of each planning call
     blocked: int
+    pulled: int = 0
     params: object = None  # DVBF params at the end (mi / learn_map)
     model: object = None  # DVBFConfig
     seconds: float = 0.0
@@ -404,6 +446,9 @@ class MIPlanner:
         self.key = jax.random.PRNGKey(seed + 91)
         self.n_hist = 400  # visited poses used for the obstacle histogram (fixed: one compilation)
         self._predicted = _scan_predictor(model)
+        if mi.pull_below is not None:  # the agent's own sensed grid, for the frontier pull
+            n = max(2, int(np.ceil(extent / mi.pull_cell)))
+            self.crossed, self.ended, self.swept = np.zeros((n, n), np.int64), np.zeros((n, n), np.int64), 0
 
     def plan(self, slam, rng: np.random.Generator) -> tuple[np.ndarray, dict]:
         """Best candidate control sequence by the mutual information ``I(x_1:T; M)`` (Section VI).
@@ -473,8 +518,48 @@ class MIPlanner:
         scores[feasible] = score_candidates(k_s, q, slam.params.emission, self.model, starts, controls[feasible],
                                             self.mi)
         best = int(np.argmax(scores))
-        return controls[best], {"scores": scores, "best": best, "penalty": cand.penalty, "grid": grid,
-                                "controls": controls, "free_steps": free, "starts": np.asarray(starts)}
+        info = {"scores": scores, "best": best, "penalty": cand.penalty, "grid": grid, "controls": controls,
+                "free_steps": free, "starts": np.asarray(starts), "pulled": False}
+        if self.mi.pull_below is not None:
+            self._sweep(slam)
+            if scores[best] < self.mi.pull_below:
+                self._pull(slam, info)
+        return info["controls"][info["best"]], info
+
+    def _sweep(self, slam) -> None:
+        """Add the scans received since the last call, at their estimated poses, to the sensed grid."""
+        from cogmap.planning.frontier_pull import sweep
+
+        t = slam.t + 1
+        sweep(self.crossed, self.ended, slam.estimates[self.swept:t], slam.scans[self.swept:t],
+              self.model.lidar_range, self.extent)
+        self.swept = t
+
+    def _pull(self, slam, info: dict) -> None:
+        """Replace the plan by the way to the nearest frontier of the sensed grid when one is reachable,
+        cut where the mean path of its controls would enter a wall cell of that grid or a neighbour of
+        one, if that leaves at least ``MIConfig.obs_every`` steps. The candidates' collision checks are
+        not applied: the obstacle histogram's cells are twice as coarse as the sensed grid the way was
+        planned on, and the scan check (two beams 18 degrees apart bound each bearing) closes doorways;
+        in corridors a few cells wide either cut the way at its first bend. A bump still re-plans."""
+        from cogmap.planning.frontier_pull import blocked, descend, free_steps, frontier_distance, pursue
+        from cogmap.planning.mi_exploration import cut_forward, mean_paths
+
+        mi = self.mi
+        dist, cost = frontier_distance(self.crossed, self.ended, mi.pull_hit_min, mi.pull_min_crossed)
+        path = descend(dist, cost, slam.estimate[:2], self.extent)
+        info["pull_path"] = path
+        if len(path) < 2:
+            return
+        u = pursue(path, slam.estimate, mi.horizon, mi.max_turn, mi.max_step)[None]
+        walls = blocked(self.crossed, self.ended, mi.pull_hit_min)
+        free = np.array([free_steps(mean_paths(u, slam.estimate)[0, :, :2], walls, self.extent)])
+        if int(free[0]) < mi.obs_every:
+            return
+        info["controls"] = np.concatenate([info["controls"], cut_forward(u, free)])
+        info["free_steps"] = np.concatenate([info["free_steps"], free])
+        info["scores"] = np.append(info["scores"], np.nan)
+        info["best"], info["pulled"] = len(info["free_steps"]) - 1, True
 
 
 def cache_dir():
@@ -608,7 +693,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         if slam is not None:
             info_curve.append((0, float(kl_map(slam.params.q_map))))
         queue: list[np.ndarray] = []
-        blocked = n_blocked = 0
+        blocked = n_blocked = n_pulled = 0
         for t in range(1, steps):
             if planner is not None:
                 if not queue:
@@ -616,6 +701,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
                     t0 = time.perf_counter()
                     u_best, info = planner.plan(slam, rng)
                     plan_seconds.append(time.perf_counter() - t0)
+                    n_pulled += int(info["pulled"])
                     # execute up to the predicted collision, rounded up to whole filter chunks (standing after it)
                     free = int(info["free_steps"][info["best"]])
                     n = min(cfg.replan_every, cfg.train_every * max(1, -(-free // cfg.train_every)))
@@ -650,7 +736,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
             if info_curve[-1][0] != steps - 1:
                 info_curve.append((steps - 1, float(kl_map(slam.params.q_map))))
         return ExploreResult(np.array(poses), np.array(controls), np.array(scans), est, ratio_curve, info_curve,
-                             plan_seconds, n_blocked, params=slam.params if slam else None,
+                             plan_seconds, n_blocked, n_pulled, params=slam.params if slam else None,
                              model=slam.config.model if slam else None, seconds=time.perf_counter() - tic)
     finally:
         sim.close()

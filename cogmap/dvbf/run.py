@@ -247,7 +247,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     """``cogmap dvbf explore``: explore maze ``maze_seed`` with the DVBF-LM agent and the baselines from the same
     start for ``steps`` steps (default: the Table II budget) and write the run directory ``out``.
 
-    The directory holds ``run.json``, ``model.npz`` + ``model.json`` (the MI agent's final q(M) and emission),
+    The directory holds ``run.json``, ``model.npz`` + ``model.json`` (the first MI agent's final q(M) and emission),
     ``trajectory.csv`` (per method and step: true pose, the agent's estimate, control), ``metrics.json``
     (exploration ratio at the budget, its curve, information gain, planning time), ``path.png`` (the paths on
     the maze) and ``ratio.png`` (exploration ratio and information gain against the steps).
@@ -266,7 +266,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     complexity, corridor : str
         Maze family (Table II).
     methods : sequence of str
-        Any of ``"mi"``, ``"random"``, ``"frontier"``.
+        Any of ``"mi"``, ``"mi-pull"`` (the DVBF-LM agent with the frontier pull), ``"random"``, ``"frontier"``.
     cache_dir : path, optional
         Where the pretrained emission is cached; default :func:`cogmap.dvbf.explore.cache_dir`.
     progress : bool
@@ -289,7 +289,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     from cogmap.envs.maze_render import save_maze_png
     from cogmap.runs import write_manifest
 
-    from .explore import STUDY_MI, ExploreConfig, explore, pretrained_emission, ratio_at
+    from .explore import STUDY_MI, explore, method_config, pretrained_emission, ratio_at
     from .explore import cache_dir as cache_dir_default
 
     out = Path(out)
@@ -299,10 +299,10 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     if maze_seed == 0:
         raise ValueError("explore_run: the emission is pretrained on maze 0; explore another maze")
     overrides = {"mi": STUDY_MI, **overrides}
-    cfgs = {m: ExploreConfig(method=m, seed=seed, **overrides) for m in methods}
+    cfgs = {m: method_config(m, seed=seed, **overrides) for m in methods}
     write_manifest(out, command="dvbf explore", maze_seed=maze_seed, complexity=complexity, corridor=corridor,
                    steps=steps, seed=seed, noise=asdict(NOISE), configs={m: c.to_json() for m, c in cfgs.items()})
-    needs_model = any(m == "mi" or c.learn_map for m, c in cfgs.items())
+    needs_model = any(c.method == "mi" or c.learn_map for c in cfgs.values())
     emission = pretrained_emission(cache_dir or cache_dir_default()) if needs_model else None
     results, metrics = {}, {"maze_seed": maze_seed, "complexity": complexity, "corridor": corridor, "steps": steps,
                             "budget": maze.step_budget, "tiles": maze.tiles, "seed": seed, "methods": {}}
@@ -317,8 +317,9 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
             bar.close()
         results[m] = res
         metrics["methods"][m] = summarise(res, maze, steps)
-    if "mi" in results and results["mi"].params is not None:
-        save_params(results["mi"].params, results["mi"].model, out)
+    agent = next((m for m in ("mi", "mi-pull") if m in results and results[m].params is not None), None)
+    if agent is not None:  # the first DVBF-LM agent's map (the paper's, else the one with the pull)
+        save_params(results[agent].params, results[agent].model, out)
     with open(out / "trajectory.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["method", "step", "true_x", "true_y", "true_heading", "est_x", "est_y", "est_heading",
@@ -330,7 +331,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
                 w.writerow([m, t, *np.round(r.poses[t], 6), *np.round(est, 6), *np.round(u, 6)])
     metrics["ratio_at_budget"] = {m: ratio_at(r.ratio_curve, steps - 1) for m, r in results.items()}
     (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
-    colours = {"mi": "tab:blue", "random": "tab:red", "frontier": "tab:green"}
+    colours = {"mi": "tab:blue", "mi-pull": "tab:purple", "random": "tab:red", "frontier": "tab:green"}
     save_maze_png(maze, out / "path.png", paths=[(f"{m} ({metrics['ratio_at_budget'][m]:.2f})", r.poses,
                                                   colours.get(m, "k")) for m, r in results.items()],
                   title=f"maze {maze_seed} ({complexity}, {corridor}): {steps} steps")
@@ -354,7 +355,7 @@ def summarise(res, maze, steps: int) -> dict:
     -------
     dict
         ``ratio_final`` and ``ratio_curve`` (exploration ratio, Appendix D), ``info_gain_curve`` and
-        ``info_gain_final`` (``KL(q(M) || p(M))`` in nats, None without a map), ``blocked_steps``,
+        ``info_gain_final`` (``KL(q(M) || p(M))`` in nats, None without a map), ``blocked_steps``, ``pulled_plans``,
         ``path_length`` (maze units), ``run_s``, ``plan_calls``, ``plan_call_median_s`` and
         ``plan_call_first_s`` (seconds, None without planning) and, with pose estimates,
         ``localisation_error_final`` / ``localisation_error_mean`` (maze units).
@@ -364,7 +365,8 @@ def summarise(res, maze, steps: int) -> dict:
     plan = np.array(res.plan_seconds) if res.plan_seconds else None
     out = {"ratio_final": ratio_at(res.ratio_curve, steps - 1), "ratio_curve": res.ratio_curve,
            "info_gain_curve": res.info_curve, "info_gain_final": res.info_curve[-1][1] if res.info_curve else None,
-           "blocked_steps": res.blocked, "path_length": float(np.sum(np.hypot(*np.diff(res.poses[:, :2], axis=0).T))),
+           "blocked_steps": res.blocked, "pulled_plans": res.pulled,
+           "path_length": float(np.sum(np.hypot(*np.diff(res.poses[:, :2], axis=0).T))),
            "run_s": res.seconds, "plan_calls": len(res.plan_seconds),
            "plan_call_median_s": float(np.median(plan)) if plan is not None else None,
            "plan_call_first_s": float(plan[0]) if plan is not None else None}

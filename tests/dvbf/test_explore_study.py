@@ -66,13 +66,19 @@ def test_cli_parses_dvbf_explore():
 
 
 def test_study_plan_and_keys():
+    from cogmap.dvbf.explore import RUN_METHODS
+    from cogmap.study.dvbf_exploration import METHODS
+
+    assert METHODS == RUN_METHODS  # the study names every method a run can
     plan = study_plan("dvbf-exploration", "reduced")
     assert plan["envs"] == ["simple-small", "moderate-small", "complex-small"]
     assert plan["steps"] == {"simple-small": 200, "moderate-small": 200, "complex-small": 200}
     assert study_plan("dvbf-exploration", "full")["steps"]["complex-large"] == 18000  # Table II
     assert len(plan["seeds"]) == 5
     specs = run_specs(plan)
-    assert len({s["key"] for s in specs}) == len(specs) == 3 * 3 * 5
+    assert len({s["key"] for s in specs}) == len(specs) == 3 * 4 * 5
+    pull = [s for s in specs if s["method"] == "mi-pull"]
+    assert pull and all(s["method_options"]["pull_below"] > 0 for s in pull)
     with pytest.raises(ValueError, match="Table II rows"):
         study_plan("dvbf-exploration", "reduced", envs=["moderate"])
     with pytest.raises(ValueError, match="method"):
