@@ -272,10 +272,12 @@ def _row(pair, which, plan: Plan, executed, blocked, goal) -> dict:
 
 
 def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config: HybridAStarConfig,
-                   progress=None) -> tuple[list[dict], dict]:
+                   progress=None, targets: dict | None = None) -> tuple[list[dict], dict]:
     """Plan every pair with every scan function (``{"learned": fn, "true": fn}``) and execute each plan
     in a noise-free simulator. Returns per-plan rows and ``{"paths": {model: [(pair, Plan, executed,
-    goal)]}, "grid_s": {model: seconds to scan the heuristic's grid}}``.
+    goal)]}, "grid_s": {model: seconds to scan the heuristic's grid}}``. With ``targets[model]``, that
+    model plans to those poses instead (e.g. goals inferred from observations) and is still judged
+    against the true goal ``poses[j]``.
 
     Parameters
     ----------
@@ -291,6 +293,8 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
         Planner settings.
     progress : callable, optional
         Called with the number of pairs done.
+    targets : dict of str to numpy.ndarray, optional
+        Model name -> planning goals ``(n_poses, 3)``, one per pose index.
 
     Returns
     -------
@@ -310,9 +314,11 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
         for name, fn in scan_fns.items():
             t = time.perf_counter()
             grids[name] = (cost_grid(fn, maze.size, config.cell), time.perf_counter() - t)
+        targets = targets or {}
         for n, (i, j) in enumerate(pairs):
             for name, fn in scan_fns.items():
-                plan = plan_path(poses[i], poses[j], fn, maze.size, config, grid=grids[name][0])
+                goal = targets[name][j] if name in targets else poses[j]
+                plan = plan_path(poses[i], goal, fn, maze.size, config, grid=grids[name][0])
                 executed, blocked = execute(sim, poses[i], plan.controls) if plan.found else (poses[i][None], 0)
                 rows.append(_row((i, j), name, plan, executed, blocked, poses[j]))
                 paths[name].append(((i, j), plan, executed, poses[j]))

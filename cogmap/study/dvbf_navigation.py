@@ -30,6 +30,12 @@ MODEL = {"full": {"map_steps": 2000, "map_iters": 3000, **_LEARN},
 # paper (Section V-B b, c; Figure 6c): every pose-to-pose plan reached its target; pose-to-observation
 # under 2 % failures; planning in the true simulator is the upper bound
 PAPER = {"pose_to_pose_success": 1.0, "pose_to_observation_failures_below": 0.02}
+METHODS = ("hybrid_astar", "pose_to_observation")
+#: the goal pose of an observation (cogmap.inference.pose_search): a table of n_xy x n_xy positions x n_heading
+#: headings scored at once, the best ``top`` entries refined by ``iters`` Adam steps (tiny: a small table for tests)
+ENCODER = {"full": {"n_xy": 50, "n_heading": 40, "top": 8, "iters": 100, "lr": 0.003}}
+ENCODER["reduced"] = ENCODER["full"]
+ENCODER["tiny"] = {"n_xy": 10, "n_heading": 8, "top": 4, "iters": 20, "lr": 0.003}
 
 
 def nav_plan(scale: str, seeds=None, methods=None, envs=None) -> dict:
@@ -39,11 +45,12 @@ def nav_plan(scale: str, seeds=None, methods=None, envs=None) -> dict:
     mazes = s["mazes"] if envs is None else [_maze_seed(e) for e in envs]
     plan = {"study": STUDY, "scale": scale, "stop_rule": "plan found, then executed open loop",
             "coverage_level": COVERAGE_LEVEL, "success_rule": {"radius": 0.05}, "aimapp_patience": None,
-            "envs": [f"maze{m}" for m in mazes], "methods": ["hybrid_astar"] if methods is None else list(methods),
+            "envs": [f"maze{m}" for m in mazes], "methods": list(METHODS) if methods is None else list(methods),
             "seeds": [0] if seeds is None else list(seeds), "steps": {f"maze{m}": 0 for m in mazes},
             "params": {"pairs": s["pairs"], "block": s["block"], "grid": 5, **MODEL[scale]}}
-    if plan["methods"] != ["hybrid_astar"]:
-        raise ValueError(f"the {STUDY} study has one method, 'hybrid_astar'; got {plan['methods']}")
+    bad = [m for m in plan["methods"] if m not in METHODS]
+    if bad or not plan["methods"]:
+        raise ValueError(f"the {STUDY} study's methods are {list(METHODS)}; got {plan['methods']}")
     return plan
 
 
@@ -62,23 +69,30 @@ def nav_specs(plan: dict) -> list[dict]:
     p = plan["params"]
     planner = json.loads(json.dumps(asdict(HybridAStarConfig())))
     specs = []
-    for env in plan["envs"]:
-        for seed in plan["seeds"]:
-            n = len(pose_pairs(GRID * GRID, p["pairs"], seed))
-            for b, first in enumerate(range(0, n, p["block"])):
-                spec = {"study": STUDY, "scale": plan["scale"], "env": env, "method": "hybrid_astar",
-                        "seed": int(seed), "level": f"block{b}", "noise": None, "steps": 0,
-                        "stop_rule": plan["stop_rule"], "coverage_level": plan["coverage_level"],
-                        "success_rule": plan["success_rule"], "method_options": {"planner": planner, "worlds": {
-                            "learned": {"k_std": STD_K}, "learned_mean": {"k_std": 0.0}, "true": "pybullet"}},
-                        "params": {**p, "first": first, "last": min(first + p["block"], n)}}
-                specs.append({"key": f"{env}__hybrid_astar__s{seed}__block{b}__{spec_digest(spec)}", **spec})
+    options = {"hybrid_astar": {"planner": planner, "worlds": {
+        "learned": {"k_std": STD_K}, "learned_mean": {"k_std": 0.0}, "true": "pybullet"}},
+        # pose-to-observation: the goal pose inferred from the goal's scan, planned to in the default world
+        "pose_to_observation": {"planner": planner, "worlds": {"observation": {"k_std": STD_K}},
+                                "encoder": ENCODER[plan["scale"]]}}
+    for method in plan["methods"]:
+        for env in plan["envs"]:
+            for seed in plan["seeds"]:
+                n = len(pose_pairs(GRID * GRID, p["pairs"], seed))
+                for b, first in enumerate(range(0, n, p["block"])):
+                    spec = {"study": STUDY, "scale": plan["scale"], "env": env, "method": method,
+                            "seed": int(seed), "level": f"block{b}", "noise": None, "steps": 0,
+                            "stop_rule": plan["stop_rule"], "coverage_level": plan["coverage_level"],
+                            "success_rule": plan["success_rule"], "method_options": options[method],
+                            "params": {**p, "first": first, "last": min(first + p["block"], n)}}
+                    specs.append({"key": f"{env}__{method}__s{seed}__block{b}__{spec_digest(spec)}", **spec})
     return specs
 
 
 LABELS = {"learned": "DVBF-LM, mean - 1 std", "learned_mean": "DVBF-LM, mean (paper)",
-          "true": "true simulator (upper bound)"}
+          "true": "true simulator (upper bound)",
+          "observation": "DVBF-LM, mean - 1 std, to the pose of the goal's scan (pose-to-observation)"}
 _MODELS: dict = {}
+_TABLES: dict = {}
 
 
 def _model(maze_seed: int, seed: int, p: dict):
@@ -95,7 +109,7 @@ def _model(maze_seed: int, seed: int, p: dict):
 
 
 def run_navigation(spec: dict) -> dict:
-    from cogmap.dvbf.navigate import GRID, grid_poses, navigate_pairs, pose_pairs, scan_models
+    from cogmap.dvbf.navigate import GRID, grid_poses, learned_scan_fn, navigate_pairs, pose_pairs, scan_models
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_sim import MazeSim
     from cogmap.planning.hybrid_astar import HybridAStarConfig, SafetyTerm
@@ -111,10 +125,19 @@ def run_navigation(spec: dict) -> dict:
     poses = grid_poses(maze, GRID, spec["seed"])
     pairs = pose_pairs(len(poses), p["pairs"], spec["seed"])[p["first"]:p["last"]]
     sim = MazeSim(maze)
+    encoded = None
     try:
         worlds = spec["method_options"]["worlds"]
-        rows, extra = navigate_pairs(maze, scan_models(params, cfg, sim, worlds["learned"]["k_std"]), poses, pairs,
-                                     config)
+        if spec["method"] == "pose_to_observation":
+            encoded = _encode_goals(sim, poses, params, cfg, spec["method_options"]["encoder"],
+                                    (maze_seed, spec["seed"]))
+            fns = {"observation": learned_scan_fn(params, cfg, worlds["observation"]["k_std"])}
+            rows, extra = navigate_pairs(maze, fns, poses, pairs, config, targets={"observation": encoded["poses"]})
+            for r in rows:
+                r["goal_estimate_error"] = encoded["errors"][r["goal"]]
+        else:
+            rows, extra = navigate_pairs(maze, scan_models(params, cfg, sim, worlds["learned"]["k_std"]), poses,
+                                         pairs, config)
     finally:
         sim.close()
     h = hashlib.sha256()
@@ -123,8 +146,37 @@ def run_navigation(spec: dict) -> dict:
             h.update(np.round(executed, 5).tobytes())
     # timing fields end in _s (cogmap.study.runs.strip_timings drops them for comparisons)
     model = {k: v for k, v in info.items() if k != "train_s"}
-    return {"rows": rows, "model": model, "model_train_s": info.get("train_s"), "grid_s": extra["grid_s"],
-            "trajectory_digest": h.hexdigest()[:16]}
+    out = {"rows": rows, "model": model, "model_train_s": info.get("train_s"), "grid_s": extra["grid_s"],
+           "trajectory_digest": h.hexdigest()[:16]}
+    if encoded is not None:
+        out["encoded_goals"] = {"poses": encoded["poses"].round(6).tolist(), "errors": encoded["errors"],
+                                "encode_s": encoded["seconds"]}
+    return out
+
+
+def _encode_goals(sim, poses, params, cfg, enc: dict, key) -> dict:
+    """The pose of each goal's scan (the simulator's LiDAR at the goal) by the pose search of
+    :mod:`cogmap.inference.pose_search` on the learned model, and its position error."""
+    import time
+
+    from cogmap.dvbf.navigate import learned_scan_fn
+    from cogmap.inference.pose_search import build_table, encode, refine
+
+    key = (*key, enc["n_xy"], enc["n_heading"])
+    if key not in _TABLES:
+        _TABLES.clear()
+        _TABLES[key] = build_table(learned_scan_fn(params, cfg, 0.0), cfg.extent, enc["n_xy"], enc["n_heading"])
+    table = _TABLES[key]
+    tic = time.perf_counter()
+    obs = sim.lidar_batch(poses)
+
+    def refine_fn(o, starts):
+        return refine(params.emission, params.q_map.mean, cfg, o, starts, sigma=cfg.sigma_e, iters=enc["iters"],
+                      lr=enc["lr"])
+
+    found = np.array([encode(o, table, cfg.sigma_e, refine_fn, top=enc["top"])[0] for o in obs])
+    errors = np.hypot(*(found[:, :2] - poses[:, :2]).T)
+    return {"poses": found, "errors": [float(e) for e in errors], "seconds": time.perf_counter() - tic}
 
 
 def nav_report(study_dir: Path, plan, results) -> str:
@@ -138,7 +190,13 @@ def nav_report(study_dir: Path, plan, results) -> str:
         rows += [{**x, "maze": r["spec"]["env"], "seed": r["spec"]["seed"]} for x in r["result"]["rows"]]
     header = ["maze", "planned in", "pairs", "plan found %", "success %", "plans that hit a wall",
               "length ratio learned / true (mean, median, max)", "time per plan median (s)", "expansions median"]
-    table = [["paper (6 mazes x 600 pairs)", "DVBF-LM", "3600", "–", "100.0", "–", "close to 1 (Figure 6c)", "–", "–"]]
+    table = []
+    if "hybrid_astar" in plan["methods"]:
+        table.append(["paper (6 mazes x 600 pairs)", "DVBF-LM", "3600", "–", "100.0", "–", "close to 1 (Figure 6c)",
+                      "–", "–"])
+    if "pose_to_observation" in plan["methods"]:
+        table.append(["paper", "DVBF-LM, pose-to-observation", "–", "–", "above 98 (under 2 % failures)", "–", "–",
+                      "–", "–"])
     groups = sorted({x["maze"] for x in rows}) + ["all"]
     summaries = {}
     for g in groups:
@@ -146,7 +204,7 @@ def nav_report(study_dir: Path, plan, results) -> str:
         # pairs are distinct per (maze, seed); summarise keys pairs by (start, goal), so per maze and seed
         s = summarise(rs) if g != "all" else _pooled(rs)
         summaries[g] = s
-        for m in ("learned", "learned_mean", "true"):
+        for m in ("learned", "learned_mean", "true", "observation"):
             if m not in s:
                 continue
             t = s[m]
@@ -162,7 +220,8 @@ def nav_report(study_dir: Path, plan, results) -> str:
     # Figure 6c: share of pairs reached within a budget of planner queries (scan evaluations)
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))
-    for m, c in (("learned", "tab:blue"), ("learned_mean", "tab:orange"), ("true", "tab:green")):
+    for m, c in (("learned", "tab:blue"), ("learned_mean", "tab:orange"), ("true", "tab:green"),
+                 ("observation", "tab:purple")):
         rs = [x for x in rows if x["model"] == m]
         if not rs:
             continue
@@ -190,9 +249,39 @@ def nav_report(study_dir: Path, plan, results) -> str:
             "of the prediction under q(M) (first order), so unexplored map reads as close; 'DVBF-LM, mean' with "
             "the prediction at the map mean, the paper's reading. Time per plan: wall clock on a shared 2-core "
             "machine, including every scan evaluation "
-            "(jitted emission for the learned model, pybullet ray casts for the simulator). Pose-to-observation "
-            "navigation (the paper's under-2 % failures) is not built.")
+            "(jitted emission for the learned model, pybullet ray casts for the simulator).")
+    enc = _encoder_table(results)
+    if enc:
+        e = ENCODER[plan["scale"]]
+        note += ("\n\nPose-to-observation (paper Section V-B c: under 2 % failures): the goal is given as the "
+                 "simulator's scan at the goal pose; its pose is the mode of p(z | x, q(M)) at the map mean "
+                 f"(cogmap.inference.pose_search: {e['n_xy']} x {e['n_xy']} positions x {e['n_heading']} headings "
+                 f"scored at once, the best {e['top']} refined by {e['iters']} Adam steps), a search of the learned "
+                 "model in place of the paper's trained pose encoder; the plan goes to that pose in the default "
+                 "world and succeeds when the executed path ends within 0.05 of the *true* goal. A goal whose scan "
+                 "aliases another place fails for every start.\n\n" + enc)
     return _md(header, table) + "\n\n" + note + "\n\n![success over planner queries](success.png)\n"
+
+
+def _encoder_table(results) -> str:
+    """Per maze: goals whose pose the search put within 0.05 of the truth, and the error quantiles."""
+    from .report import _md
+
+    seen = {}
+    for r in results:
+        g = r["result"].get("encoded_goals")
+        if g is not None:
+            seen.setdefault((r["spec"]["env"], r["spec"]["seed"]), g["errors"])
+    if not seen:
+        return ""
+    rows, every = [], []
+    for (env, seed), errs in sorted(seen.items()):
+        e = np.array(errs)
+        every.append(e)
+        rows.append([env, seed, f"{int((e <= 0.05).sum())} / {e.size}", f"{np.median(e):.3f}", f"{e.max():.3f}"])
+    e = np.concatenate(every)
+    rows.append(["all", "–", f"{int((e <= 0.05).sum())} / {e.size}", f"{np.median(e):.3f}", f"{e.max():.3f}"])
+    return _md(["maze", "seed", "goal poses found within 0.05", "median error", "max error"], rows)
 
 
 def _pooled(rows):

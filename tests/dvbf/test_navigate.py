@@ -111,11 +111,33 @@ def test_study_specs_are_blocks_of_pairs():
     from cogmap.study.config import run_specs, study_plan
 
     full = run_specs(study_plan("dvbf-navigation", "full"))
-    assert len(full) == 6 * 6  # six mazes, 600 pairs each in blocks of 100
-    assert sum(s["params"]["last"] - s["params"]["first"] for s in full) == 3600
+    assert len(full) == 2 * 6 * 6  # pose-to-pose and pose-to-observation; six mazes, 600 pairs each in blocks of 100
+    for method in ("hybrid_astar", "pose_to_observation"):
+        assert sum(s["params"]["last"] - s["params"]["first"] for s in full if s["method"] == method) == 3600
     assert len({s["key"] for s in full}) == len(full)
+    with pytest.raises(ValueError, match="methods"):
+        study_plan("dvbf-navigation", "full", methods=["dijkstra"])
     reduced = run_specs(study_plan("dvbf-navigation", "reduced"))
-    assert [s["env"] for s in reduced] == ["maze1", "maze2"]
+    assert [s["env"] for s in reduced] == ["maze1", "maze2"] * 2
     with pytest.raises(ValueError, match="maze<seed>"):
         study_plan("dvbf-navigation", "reduced", envs=["house"])
     assert json.loads(json.dumps(full[0])) == full[0]
+
+
+def test_pose_to_observation_study_runs_and_reports(tmp_path):
+    from cogmap.study.runner import load_runs, run_study
+
+    run = run_study("dvbf-navigation", tmp_path, scale="tiny", methods=["pose_to_observation"], progress=False)
+    assert run["complete"] and run["runs"] == 1
+    (rec,) = load_runs(tmp_path / "dvbf-navigation").values()
+    res = rec["result"]
+    rows = res["rows"]
+    assert len(rows) == 2 and {r["model"] for r in rows} == {"observation"}
+    # the plans went to the inferred goals and are judged at the true ones
+    enc = res["encoded_goals"]
+    assert len(enc["poses"]) == len(enc["errors"]) == 25
+    for r in rows:
+        assert r["goal_estimate_error"] == enc["errors"][r["goal"]]
+        assert r["success"] == (r["found"] and r["final_error"] <= 0.05)
+    table = (tmp_path / "dvbf-navigation" / "table.md").read_text()
+    assert "pose-to-observation" in table and "goal poses found within 0.05" in table
