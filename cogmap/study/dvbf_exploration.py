@@ -208,6 +208,16 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
             "learnt map, candidate optimisation, MI of every candidate), wall clock on this shared 2-core machine. "
             "MI settings of the study (not the paper's, which are about 100 times heavier): "
             f"{asdict_short(plan)}. Mean ± std over seeds; the shaded band in ratio.png is one std.")
+    if "mi-pull" in plan["methods"]:
+        from cogmap.dvbf.explore import PULL_BELOW
+        from cogmap.planning.mi_exploration import MIConfig
+
+        d = MIConfig()
+        note += (f" {LABEL['mi-pull']}: the same agent and settings, but when no candidate's MI reaches {PULL_BELOW} "
+                 "nats it follows the cheapest path on its own sensed grid (its estimated poses and the scans it "
+                 f"received there; cells of {d.pull_cell}, a wall where at least {d.pull_hit_min} returns ended, "
+                 f"passable where at least {d.pull_min_crossed} beams crossed) to the nearest frontier of that grid "
+                 "(cogmap.planning.frontier_pull); our addition, not the paper's.")
     missing = [e for e in ALL_LEVELS if e not in plan["envs"]]
     if missing:
         note += (f" Table II rows not run in this study directory: {', '.join(missing)}"
