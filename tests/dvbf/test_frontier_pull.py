@@ -122,3 +122,45 @@ def test_pursue_follows_a_path_round_a_corner():
     assert np.isclose(abs(back[0, 0]), np.pi) and np.allclose(back[1:, 0], 0.0)
     with pytest.raises(ValueError, match="non-empty"):
         pursue(np.zeros((0, 2)), np.zeros(3), 5, 0.35, 0.01)
+
+
+def test_the_pull_leads_a_robot_out_of_what_it_has_sensed_in_a_pybullet_maze():
+    """The explorer's pull on the grid of a 300-step operator walk (its scans at the true poses): the
+    controls, executed in the pybullet maze, hit no wall and reach a frontier of that grid."""
+    import dataclasses
+    from types import SimpleNamespace
+
+    from cogmap.dvbf.explore import STUDY_MI, MIPlanner
+    from cogmap.envs.maze import make_maze
+    from cogmap.envs.maze_sim import MazeSim
+    from cogmap.envs.maze_traversal import traverse
+    from cogmap.genmodel.dvbf import DVBFConfig
+
+    maze = make_maze(2, "moderate", "small")
+    tr = traverse(maze, 300, seed=3)
+    mi = dataclasses.replace(STUDY_MI, pull_below=1.0)
+    planner = MIPlanner(DVBFConfig(extent=maze.size, map_side=maze.map_side), mi, maze.size, seed=0)
+    slam = SimpleNamespace(t=len(tr.poses) - 1, estimates=tr.poses, scans=tr.scans, estimate=tr.poses[-1])
+    planner._sweep(slam)
+    assert planner.swept == len(tr.poses) and planner.crossed.sum() > 0
+    info = {"controls": np.zeros((0, mi.horizon, 2)), "free_steps": np.zeros(0, int), "scores": np.zeros(0),
+            "best": 0, "pulled": False}
+    planner._pull(slam, info)
+    assert info["pulled"] and info["best"] == 0 and info["free_steps"][0] >= mi.obs_every
+    dist, _ = frontier_distance(planner.crossed, planner.ended, mi.pull_hit_min, mi.pull_min_crossed)
+    side = dist.shape[0]
+    start = tuple(np.clip((tr.poses[-1, :2] / maze.size * side).astype(int), 0, side - 1))
+    goal = np.floor(info["pull_path"][-1] / maze.size * side).astype(int)
+    assert dist[tuple(goal)] == 0 and dist[start] > 0
+    with MazeSim(maze) as sim:
+        sim.reset(tr.poses[-1])
+        hits, trail = 0, []
+        for u in info["controls"][0][: info["free_steps"][0]]:
+            pose, hit = sim.step(u)
+            hits += int(hit)
+            trail.append(pose[:2])
+    assert hits == 0
+    # the executed path ends at most half as far from the frontier as it started (measured: 13.1 -> 2.8 cells)
+    cells = np.clip((np.array(trail) / maze.size * side).astype(int), 0, side - 1)
+    d_end = dist[cells[-1, 0], cells[-1, 1]]
+    assert d_end <= 0.5 * dist[start] or np.isinf(d_end)  # inf: it has left the sensed grid past the frontier
