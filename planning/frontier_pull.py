@@ -8,16 +8,17 @@ received at them.
 
 * :func:`sweep` counts, per cell of a grid over ``[0, extent]^2``, the beams that crossed it and the
   beams that ended in it (a return shorter than the LiDAR range);
-* :func:`cell_cost` prices each cell: a wall where ``hit_min`` or more returns ended, a fair share of
-  the beams through it (hit/miss counts); passable where
-  at least ``min_crossed`` beams crossed and no wall is in it or beside it (8-neighbours); dearer
-  within 3 cells of a wall, so paths keep to the middle of a corridor;
+* :func:`cell_cost` prices each cell: a wall where ``hit_min`` or more returns ended and they are a
+  fair share of the beams through it (hit/miss counts); passable where at least ``min_crossed`` beams
+  crossed and no wall is in it or beside it (8-neighbours, :func:`blocked`); dearer within 3 cells of
+  a wall, so paths keep to the middle of a corridor;
 * :func:`frontier_distance` is the least path cost (8-connected Dijkstra) from every passable cell to
   the nearest frontier cell: passable, next to a cell not yet known (too few beams, not a wall);
 * :func:`descend` follows that field downhill from the agent's cell, the cheapest path to the
   nearest frontier;
 * :func:`pursue` turns a path into ``steps`` controls of the kinematic mean transition (turn toward a
-  point ``lookahead`` ahead on the path, at most ``max_turn``; a full step).
+  point ``lookahead`` ahead on the path, at most ``max_turn``; a full step), and :func:`free_steps`
+  says how many of them stay out of :func:`blocked` cells.
 
 How the explorer uses the result (taken instead of the best candidate when the candidates' mutual
 information says nothing is left to learn within the horizon) is in :mod:`cogmap.dvbf.explore`.
