@@ -91,8 +91,10 @@ def _dvbf_navigate(args) -> int:
     from .dvbf.navigate import navigate_run
 
     metrics = navigate_run(args.maze, Path(args.out), pairs=args.pairs, seed=args.seed,
-                           model_dir=Path(args.model) if args.model else None, progress=not args.quiet)
-    shown = ("maze_seed", "pairs", "learned", "learned_mean", "true", "length_ratio", "length_ratio_learned_mean")
+                           model_dir=Path(args.model) if args.model else None, progress=not args.quiet,
+                           observation_goals=args.observation_goals)
+    shown = ("maze_seed", "pairs", "learned", "learned_mean", "true", "observation", "length_ratio",
+             "length_ratio_learned_mean")
     print(json.dumps({k: v for k, v in metrics.items() if k in shown}, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, pairs.csv, poses.csv, metrics.json, paths.png)")
     return 0
@@ -203,6 +205,8 @@ def build_parser() -> argparse.ArgumentParser:
     dn = vsub.add_parser("navigate", help="hybrid A* in a learned DVBF-LM, executed in the maze, against planning "
                                           "in the true simulator")
     dn.add_argument("--maze", type=int, default=1, help="maze seed (default: 1)")
+    dn.add_argument("--observation-goals", action="store_true",
+                    help="also plan to the pose found for each goal's scan (pose-to-observation)")
     dn.add_argument("--pairs", type=positive_int, default=40,
                     help="seeded subset of the 600 ordered pairs of the 5 x 5 pose grid (default: 40)")
     dn.add_argument("--model", default=None,

@@ -396,11 +396,75 @@ def scan_models(params, cfg, sim, k_std: float = STD_K) -> dict:
             "true": sim.lidar_batch}
 
 
+#: the pose search of pose-to-observation (:mod:`cogmap.inference.pose_search`): a table of n_xy x n_xy
+#: positions x n_heading headings scored at once, the best ``top`` refined by ``iters`` Adam steps
+ENCODER = {"n_xy": 50, "n_heading": 40, "top": 8, "iters": 100, "lr": 0.003}
+
+
+def goal_table(params, cfg, encoder: dict = ENCODER):
+    """The learned model's predicted scans on the pose grid of ``encoder`` (map mean), for :func:`encode_goals`.
+
+    Parameters
+    ----------
+    params : DVBFParams
+        The learned q(M) and emission.
+    cfg : DVBFConfig
+        Their model.
+    encoder : dict
+        ``n_xy`` and ``n_heading`` (see :data:`ENCODER`).
+
+    Returns
+    -------
+    PoseTable
+    """
+    from cogmap.inference.pose_search import build_table
+
+    return build_table(learned_scan_fn(params, cfg, 0.0), cfg.extent, encoder["n_xy"], encoder["n_heading"])
+
+
+def encode_goals(sim, poses, params, cfg, encoder: dict = ENCODER, table=None) -> dict:
+    """Pose-to-observation goals: the pose of each goal's scan (the simulator's LiDAR at ``poses``) by the
+    pose search on the learned model, and its position error against the true pose.
+
+    Parameters
+    ----------
+    sim : MazeSim
+        The simulator that takes the goal scans.
+    poses : numpy.ndarray, shape (n, 3)
+        The true goal poses.
+    params, cfg
+        The learned model.
+    encoder : dict
+        Search settings (:data:`ENCODER`).
+    table : PoseTable, optional
+        A table from :func:`goal_table` (built here if None).
+
+    Returns
+    -------
+    dict
+        ``poses`` (n, 3) found, ``errors`` (list of position errors, maze units), ``seconds`` (search
+        wall clock, without building the table).
+    """
+    from cogmap.inference.pose_search import encode, refine
+
+    table = goal_table(params, cfg, encoder) if table is None else table
+    tic = time.perf_counter()
+    obs = sim.lidar_batch(poses)
+
+    def refine_fn(o, starts):
+        return refine(params.emission, params.q_map.mean, cfg, o, starts, sigma=cfg.sigma_e,
+                      iters=encoder["iters"], lr=encoder["lr"])
+
+    found = np.array([encode(o, table, cfg.sigma_e, refine_fn, top=encoder["top"])[0] for o in obs])
+    errors = np.hypot(*(found[:, :2] - np.asarray(poses)[:, :2]).T)
+    return {"poses": found, "errors": [float(e) for e in errors], "seconds": time.perf_counter() - tic}
+
+
 def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40, seed: int = 0,
                  complexity: str = "moderate", corridor: str = "medium", model_dir: Path | None = None,
                  map_steps: int = 2000, map_iters: int = 3000, pretrain_maze: int | None = None,
                  pretrain_iters: int = 1500, config: HybridAStarConfig | None = None, progress: bool = True,
-                 model=None, grid: int = GRID) -> dict:
+                 model=None, grid: int = GRID, observation_goals: bool = False) -> dict:
     """Navigation on maze ``maze_seed``: learn (or load) the model, plan and execute ``pairs`` seeded
     pose pairs (None: all ordered pairs; 600 for the 5 x 5 grid) in the learned model and in the true
     simulator, and write the run directory to ``out`` (if given). ``model``: an already learnt
@@ -436,12 +500,15 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
         An already learnt ``(params, cfg, info)``; takes precedence over ``model_dir``.
     grid : int
         Poses per side.
+    observation_goals : bool
+        Also plan pose-to-observation: to the pose :func:`encode_goals` finds for each goal's scan, in the
+        ``learned`` reading (world ``observation``; success still at the true goal).
 
     Returns
     -------
     dict
         The maze, seed, number of pairs, :data:`SUCCESS_RADIUS`, the model's ``info``, ``grid_s``
-        and the entries of :func:`summarise`.
+        and the entries of :func:`summarise`; with ``observation_goals`` also ``goal_errors``.
 
     Raises
     ------
@@ -474,8 +541,14 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
 
         bar = tqdm(total=len(chosen), desc=f"maze {maze_seed} pairs", unit="pair")
     try:
-        rows, extra = navigate_pairs(maze, scan_models(params, cfg, true_sim), poses, chosen, config,
-                                     progress=(lambda n: bar.update(1)) if bar else None)
+        worlds, targets, encoded = scan_models(params, cfg, true_sim), {}, None
+        if observation_goals:
+            encoded = encode_goals(true_sim, poses, params, cfg)
+            worlds["observation"], targets["observation"] = worlds["learned"], encoded["poses"]
+        rows, extra = navigate_pairs(maze, worlds, poses, chosen, config,
+                                     progress=(lambda n: bar.update(1)) if bar else None, targets=targets)
+        for r in rows:
+            r["goal_estimate_error"] = encoded["errors"][r["goal"]] if r["model"] == "observation" else None
     finally:
         true_sim.close()
         if bar is not None:
@@ -483,6 +556,8 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     metrics = {"maze_seed": maze_seed, "complexity": complexity, "corridor": corridor, "seed": seed,
                "pairs": len(chosen), "success_radius": SUCCESS_RADIUS, "model": info,
                "grid_s": extra["grid_s"], **summarise(rows)}
+    if encoded is not None:
+        metrics["goal_errors"] = encoded["errors"]
     if out is not None:
         _write_run(Path(out), maze, params, cfg, poses, rows, extra["paths"], metrics, config, locals_=dict(
             maze_seed=maze_seed, pairs=pairs, seed=seed, complexity=complexity, corridor=corridor,

@@ -113,7 +113,16 @@ def _model(maze_seed: int, seed: int, p: dict):
 
 
 def run_navigation(spec: dict) -> dict:
-    from cogmap.dvbf.navigate import GRID, grid_poses, learned_scan_fn, navigate_pairs, pose_pairs, scan_models
+    from cogmap.dvbf.navigate import (
+        GRID,
+        encode_goals,
+        goal_table,
+        grid_poses,
+        learned_scan_fn,
+        navigate_pairs,
+        pose_pairs,
+        scan_models,
+    )
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_sim import MazeSim
     from cogmap.planning.hybrid_astar import HybridAStarConfig, SafetyTerm
@@ -133,8 +142,11 @@ def run_navigation(spec: dict) -> dict:
     try:
         worlds = spec["method_options"]["worlds"]
         if spec["method"] == "pose_to_observation":
-            encoded = _encode_goals(sim, poses, params, cfg, spec["method_options"]["encoder"],
-                                    (maze_seed, spec["seed"]))
+            key = (maze_seed, spec["seed"], p["map_steps"], tuple(sorted(spec["method_options"]["encoder"].items())))
+            if key not in _TABLES:
+                _TABLES.clear()  # one table in memory at a time
+                _TABLES[key] = goal_table(params, cfg, spec["method_options"]["encoder"])
+            encoded = encode_goals(sim, poses, params, cfg, spec["method_options"]["encoder"], _TABLES[key])
             fns = {"observation": learned_scan_fn(params, cfg, worlds["observation"]["k_std"])}
             rows, extra = navigate_pairs(maze, fns, poses, pairs, config, targets={"observation": encoded["poses"]})
             for r in rows:
@@ -156,31 +168,6 @@ def run_navigation(spec: dict) -> dict:
         out["encoded_goals"] = {"poses": encoded["poses"].round(6).tolist(), "errors": encoded["errors"],
                                 "encode_s": encoded["seconds"]}
     return out
-
-
-def _encode_goals(sim, poses, params, cfg, enc: dict, key) -> dict:
-    """The pose of each goal's scan (the simulator's LiDAR at the goal) by the pose search of
-    :mod:`cogmap.inference.pose_search` on the learned model, and its position error."""
-    import time
-
-    from cogmap.dvbf.navigate import learned_scan_fn
-    from cogmap.inference.pose_search import build_table, encode, refine
-
-    key = (*key, enc["n_xy"], enc["n_heading"])
-    if key not in _TABLES:
-        _TABLES.clear()
-        _TABLES[key] = build_table(learned_scan_fn(params, cfg, 0.0), cfg.extent, enc["n_xy"], enc["n_heading"])
-    table = _TABLES[key]
-    tic = time.perf_counter()
-    obs = sim.lidar_batch(poses)
-
-    def refine_fn(o, starts):
-        return refine(params.emission, params.q_map.mean, cfg, o, starts, sigma=cfg.sigma_e, iters=enc["iters"],
-                      lr=enc["lr"])
-
-    found = np.array([encode(o, table, cfg.sigma_e, refine_fn, top=enc["top"])[0] for o in obs])
-    errors = np.hypot(*(found[:, :2] - poses[:, :2]).T)
-    return {"poses": found, "errors": [float(e) for e in errors], "seconds": time.perf_counter() - tic}
 
 
 def nav_report(study_dir: Path, plan, results) -> str:

@@ -102,9 +102,22 @@ def test_navigate_run_directory(tmp_path, small_model):
     assert len(rows) == 1 + 3 and rows[0].startswith("start,goal,model,found,success")  # learned, learned_mean, true
 
 
+def test_navigate_run_plans_to_the_poses_of_goal_scans(tmp_path, small_model):
+    maze, model = small_model
+    metrics = navigate_run(maze.seed, tmp_path / "obs", pairs=2, complexity="simple", corridor="medium", model=model,
+                           progress=False, grid=3, config=COARSE, observation_goals=True)
+    assert metrics["observation"]["pairs"] == 2 and len(metrics["goal_errors"]) == 9
+    # the search finds most goal poses in this small model (measured: 8 of 9 within 0.05)
+    assert sum(e <= 0.05 for e in metrics["goal_errors"]) >= 6
+    rows = (tmp_path / "obs" / "pairs.csv").read_text().splitlines()
+    assert len(rows) == 1 + 2 * 4 and "goal_estimate_error" in rows[0]
+
+
 def test_cli_parses_dvbf_navigate():
     args = build_parser().parse_args(["dvbf", "navigate", "--maze", "3", "--pairs", "10", "--out", "x"])
     assert (args.maze, args.pairs, args.out, args.dvbf_command, args.model) == (3, 10, "x", "navigate", None)
+    assert not args.observation_goals
+    assert build_parser().parse_args(["dvbf", "navigate", "--observation-goals"]).observation_goals
 
 
 def test_study_specs_are_blocks_of_pairs():
@@ -117,6 +130,10 @@ def test_study_specs_are_blocks_of_pairs():
     assert len({s["key"] for s in full}) == len(full)
     with pytest.raises(ValueError, match="methods"):
         study_plan("dvbf-navigation", "full", methods=["dijkstra"])
+    from cogmap.dvbf.navigate import ENCODER
+    from cogmap.study.dvbf_navigation import ENCODER as STUDY_ENCODER
+
+    assert STUDY_ENCODER["full"] == ENCODER  # the study searches goal poses as cogmap dvbf navigate does
     reduced = run_specs(study_plan("dvbf-navigation", "reduced"))
     assert [s["env"] for s in reduced] == ["maze1", "maze2"] * 2
     with pytest.raises(ValueError, match="maze<seed>"):
