@@ -206,8 +206,9 @@ def nav_report(study_dir: Path, plan, results) -> str:
                           f"{100 * t['found'] / t['pairs']:.1f}", f"{100 * t['success_rate']:.1f}", t["collided"],
                           ratio, f"{t['plan_s_median']:.2f}", f"{t['expansions_median']:.0f}"])
     _csv(study_dir / "table.csv", header, table)
-    _csv(study_dir / "pairs.csv", ["maze", "seed", *[k for k in rows[0] if k not in ("maze", "seed")]],
-         [[x["maze"], x["seed"], *[v for k, v in x.items() if k not in ("maze", "seed")]] for x in rows])
+    cols = list(dict.fromkeys(k for x in rows for k in x if k not in ("maze", "seed")))  # pose-to-observation adds one
+    _csv(study_dir / "pairs.csv", ["maze", "seed", *cols], [[x["maze"], x["seed"], *[x.get(k, "") for k in cols]]
+                                                             for x in rows])
     # Figure 6c: share of pairs reached within a budget of planner queries (scan evaluations)
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 4))

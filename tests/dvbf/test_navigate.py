@@ -144,10 +144,10 @@ def test_study_specs_are_blocks_of_pairs():
 def test_pose_to_observation_study_runs_and_reports(tmp_path):
     from cogmap.study.runner import load_runs, run_study
 
-    run = run_study("dvbf-navigation", tmp_path, scale="tiny", methods=["pose_to_observation"], progress=False)
-    assert run["complete"] and run["runs"] == 1
-    (rec,) = load_runs(tmp_path / "dvbf-navigation").values()
-    res = rec["result"]
+    run = run_study("dvbf-navigation", tmp_path, scale="tiny", progress=False)  # both methods
+    assert run["complete"] and run["runs"] == 2
+    recs = {r["spec"]["method"]: r for r in load_runs(tmp_path / "dvbf-navigation").values()}
+    res = recs["pose_to_observation"]["result"]
     rows = res["rows"]
     assert len(rows) == 2 and {r["model"] for r in rows} == {"observation"}
     # the plans went to the inferred goals and are judged at the true ones
@@ -158,3 +158,10 @@ def test_pose_to_observation_study_runs_and_reports(tmp_path):
         assert r["success"] == (r["found"] and r["final_error"] <= 0.05)
     table = (tmp_path / "dvbf-navigation" / "table.md").read_text()
     assert "pose-to-observation" in table and "goal poses found within 0.05" in table
+    import csv
+
+    with open(tmp_path / "dvbf-navigation" / "pairs.csv") as f:
+        got = list(csv.DictReader(f))
+    assert len(got) == 2 * 3 + 2 and {r["model"] for r in got} == {"learned", "learned_mean", "true", "observation"}
+    for r in got:  # one column per field whichever method wrote the row
+        assert (r["goal_estimate_error"] != "") == (r["model"] == "observation") and r["success"] in ("True", "False")
