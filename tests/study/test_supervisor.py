@@ -60,8 +60,10 @@ def test_ctrl_c_stops_a_study_quickly_keeps_finished_runs_and_leaves_no_process(
     # of one seed take about 2 s, and once finished them all before the signal)
     cmd = [sys.executable, "-m", "cogmap.cli", "reproduce", "exploration", "--scale", "tiny", "--out",
            str(tmp_path), "--workers", "2", "--quiet", "--seeds", "0", "1", "2"]
+    # the child gets Ctrl-C as from a terminal: if anything in this test process has set SIGINT to be
+    # ignored, a child would inherit that and never see the signal
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+                            start_new_session=True, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     runs = tmp_path / "exploration" / "runs"
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and not (runs.exists() and any(runs.glob("*.json"))):
