@@ -176,26 +176,6 @@ def free_steps(positions, mask, extent: float) -> int:
     return int(hit.argmax()) if hit.any() else len(ij)
 
 
-def _steps(cost: np.ndarray):
-    """Edges ``(rows, cols, weights)`` of the 8-connected graph over the finite cells of ``cost``
-    (flat indices; a diagonal step needs both side cells finite); weight = length x mean cost."""
-    ok = np.isfinite(cost)
-    n = ok.shape[0]
-    flat = np.arange(n * n).reshape(n, n)
-    rows, cols, w = [], [], []
-    for di, dj in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        lo, hi = max(0, -dj), n - max(0, dj)
-        a, b = ok[0:n - di, lo:hi], ok[di:n, lo + dj:hi + dj]
-        both = a & b
-        if di and dj:
-            both &= ok[di:n, lo:hi] & ok[0:n - di, lo + dj:hi + dj]
-        length = np.sqrt(2.0) if di and dj else 1.0
-        rows.append(flat[0:n - di, lo:hi][both])
-        cols.append(flat[di:n, lo + dj:hi + dj][both])
-        w.append(length * 0.5 * (cost[0:n - di, lo:hi][both] + cost[di:n, lo + dj:hi + dj][both]))
-    return np.concatenate(rows), np.concatenate(cols), np.concatenate(w)
-
-
 def frontier_distance(crossed, ended, hit_min: int = 2, min_crossed: int = 3, near_wall: float = 3.0,
                       wall_fraction: float = 0.3) -> tuple[np.ndarray, np.ndarray]:
     """Least path cost from every passable cell to the nearest frontier cell.
@@ -219,8 +199,9 @@ def frontier_distance(crossed, ended, hit_min: int = 2, min_crossed: int = 3, ne
     cost : numpy.ndarray, shape (side, side)
         The cell costs the paths were priced with (for :func:`descend`).
     """
-    from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
+
+    from .grid_graph import grid_graph
 
     crossed, ended = np.asarray(crossed), np.asarray(ended)
     cost = cell_cost(crossed, ended, hit_min, min_crossed, near_wall, wall_fraction)
@@ -231,8 +212,7 @@ def frontier_distance(crossed, ended, hit_min: int = 2, min_crossed: int = 3, ne
     n = ok.shape[0]
     if not frontier.any():
         return np.full(ok.shape, np.inf), cost
-    rows, cols, w = _steps(cost)
-    graph = coo_matrix((w, (rows, cols)), shape=(n * n, n * n)).tocsr()
+    graph = grid_graph(ok, cost)
     d = dijkstra(graph, directed=False, indices=np.flatnonzero(frontier.ravel()), min_only=True)
     return np.where(ok.ravel(), d, np.inf).reshape(n, n), cost
 

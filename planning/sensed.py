@@ -269,21 +269,12 @@ def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.n
     Hw, Ww = passable.shape
     passable[src[:, 0], src[:, 1]] = True  # a source is walkable even at the fringe of a wall
     # 8-connected graph of the window's passable cells; multi-source Dijkstra
-    flat = np.arange(Hw * Ww).reshape(Hw, Ww)
-    i, j, w = [], [], []
-    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        lo, hi = max(0, -dc), Ww - max(0, dc)
-        a, b = passable[0:Hw - dr, lo:hi], passable[dr:Hw, lo + dc:hi + dc]
-        both = a & b
-        if dr and dc:  # a diagonal step needs both side cells passable (no corner cutting)
-            both &= passable[dr:Hw, lo:hi] & passable[0:Hw - dr, lo + dc:hi + dc]
-        i.append(flat[0:Hw - dr, lo:hi][both])
-        j.append(flat[dr:Hw, lo + dc:hi + dc][both])
-        w.append(np.full(int(both.sum()), np.sqrt(2.0) if dr and dc else 1.0))
-    from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import dijkstra
 
-    graph = coo_matrix((np.concatenate(w), (np.concatenate(i), np.concatenate(j))), shape=(Hw * Ww, Hw * Ww)).tocsr()
+    from .grid_graph import grid_graph
+
+    flat = np.arange(Hw * Ww).reshape(Hw, Ww)
+    graph = grid_graph(passable)
     start = flat[src[:, 0], src[:, 1]]
     # the first source of each cell wins ties, as "lower index" (sources are visited in order)
     order = np.argsort(src_idx, kind="stable")

@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import ndimage
-from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import dijkstra
 
-SQRT2 = float(np.sqrt(2.0))
+from cogmap.planning.grid_graph import grid_graph
 
 
 def coarsen(blocked: np.ndarray, factor: int) -> np.ndarray:
@@ -43,23 +42,7 @@ def shortest_paths(blocked: np.ndarray, start_rc) -> tuple[np.ndarray, np.ndarra
     free = ~np.asarray(blocked, bool)
     r0, c0 = int(start_rc[0]), int(start_rc[1])
     free[r0, c0] = True
-    idx = np.arange(H * W).reshape(H, W)
-    rows, cols, wts = [], [], []
-    for dr, dc in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        lo, hi = max(0, -dc), W - max(0, dc)
-        a, b = free[0:H - dr, lo:hi], free[dr:H, lo + dc:hi + dc]
-        ok = a & b
-        w = 1.0
-        if dr and dc:  # no corner cutting: both side cells must be free
-            ok &= free[dr:H, lo:hi] & free[0:H - dr, lo + dc:hi + dc]
-            w = SQRT2
-        rows.append(idx[0:H - dr, lo:hi][ok])
-        cols.append(idx[dr:H, lo + dc:hi + dc][ok])
-        wts.append(np.full(int(ok.sum()), w))
-    r = np.concatenate(rows)
-    c = np.concatenate(cols)
-    w = np.concatenate(wts)
-    graph = coo_matrix((w, (r, c)), shape=(H * W, H * W)).tocsr()
+    graph = grid_graph(free)
     dist, pred = dijkstra(graph, directed=False, indices=r0 * W + c0, return_predecessors=True)
     return dist.reshape(H, W), pred
 
