@@ -81,7 +81,7 @@ def _dvbf(args) -> int:
 
     pre = None if args.pretrain_maze < 0 else args.pretrain_maze
     metrics = slam_run(args.maze, args.steps, Path(args.out), seed=args.seed, progress=not args.quiet,
-                       pretrain_maze=pre)
+                       pretrain_maze=pre, offline=args.offline)
     print(json.dumps(metrics, indent=1))
     print(f"run written to {args.out}/ (model.npz/json, trajectory.csv, metrics.json, error.png, map.png)")
     return 0
@@ -191,7 +191,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     v = sub.add_parser("dvbf", help="DVBF-LM in the LiDAR mazes")
     vsub = v.add_subparsers(dest="dvbf_command", required=True)
-    ds = vsub.add_parser("slam", help="online SLAM on one seeded maze (unit square), against path integration")
+    ds = vsub.add_parser("slam", help="online (or offline) SLAM on one seeded maze (unit square), against path "
+                                      "integration")
+    ds.add_argument("--offline", action="store_true",
+                    help="offline SLAM: all steps optimised at once, in rounds of ELBO training and a full "
+                         "1,000-particle filter pass (paper Appendix B-I)")
     ds.add_argument("--maze", type=int, default=1, help="maze seed (default: 1)")
     ds.add_argument("--pretrain-maze", type=int, default=0,
                     help="maze whose traversal with known poses pretrains the emission, then frozen "

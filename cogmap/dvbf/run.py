@@ -118,8 +118,9 @@ def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "mod
 
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
              complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
-             pretrain_steps: int = 2000, pretrain_iters: int = 1500, **overrides) -> dict:
-    """Run online SLAM on maze ``maze_seed`` for ``steps`` steps and write the run directory to ``out``.
+             pretrain_steps: int = 2000, pretrain_iters: int = 1500, offline: bool = False, **overrides) -> dict:
+    """Run online SLAM (or, with ``offline``, offline SLAM: :mod:`cogmap.dvbf.offline`) on maze
+    ``maze_seed`` for ``steps`` steps and write the run directory to ``out``.
 
     With ``pretrain_maze`` (default 0), the emission network is first trained with known poses on a
     ``pretrain_steps`` traversal of that maze and then frozen; online SLAM learns only q(M).
@@ -145,8 +146,10 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
         Length of that pretraining traversal.
     pretrain_iters : int
         ELBO steps of the pretraining.
+    offline : bool
+        Optimise all steps at once (:func:`~cogmap.dvbf.offline.offline_slam`) instead of the online sweep.
     **overrides
-        :class:`SLAMConfig` fields.
+        :class:`SLAMConfig` fields, or :class:`~cogmap.dvbf.offline.OfflineConfig` fields with ``offline``.
 
     Returns
     -------
@@ -175,8 +178,14 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
         first = traverse(make_maze(pretrain_maze, complexity, corridor), pretrain_steps, seed=seed + 1000, noise=NOISE)
         emission, _ = pretrain_emission(first.poses, first.scans, model, iters=pretrain_iters, seed=seed)
         overrides = {"freeze_emission": True, **overrides}
-    config = SLAMConfig(model=model, seed=seed, **overrides)
-    write_manifest(out, command="dvbf slam", maze_seed=maze_seed, complexity=complexity, corridor=corridor,
+    if offline:
+        from .offline import OfflineConfig
+
+        config = OfflineConfig(model=model, seed=seed, **overrides)
+    else:
+        config = SLAMConfig(model=model, seed=seed, **overrides)
+    label = "offline" if offline else "online"
+    write_manifest(out, command="dvbf slam", mode=label, maze_seed=maze_seed, complexity=complexity, corridor=corridor,
                    steps=steps, seed=seed, pretrain_maze=pretrain_maze, pretrain_steps=pretrain_steps,
                    pretrain_iters=pretrain_iters,
                    noise=asdict(NOISE), config=config.to_json())
@@ -184,7 +193,8 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=steps - 1, desc="online SLAM", unit="step")
+        bar = tqdm(total=config.rounds if offline else steps - 1, desc=f"{label} SLAM",
+                   unit="round" if offline else "step")
     last = [0]
 
     def tick(t):
@@ -192,7 +202,12 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
             bar.update(t - last[0])
             last[0] = t
 
-    res = online_slam(tr.scans, tr.controls, tr.poses[0], config, progress=tick, emission=emission)
+    if offline:
+        from .offline import offline_slam
+
+        res = offline_slam(tr.scans, tr.controls, tr.poses[0], config, progress=tick, emission=emission)
+    else:
+        res = online_slam(tr.scans, tr.controls, tr.poses[0], config, progress=tick, emission=emission)
     if bar is not None:
         bar.close()
     pi = path_integration(tr.poses[0], tr.controls)
@@ -207,7 +222,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
             w.writerow([t, *np.round(tr.poses[t], 6), *np.round(res.estimates[t], 6), *np.round(res.spreads[t], 6),
                         *np.round(pi[t], 6), round(float(err[t]), 6), round(float(err_pi[t]), 6)])
     metrics = {
-        "maze_seed": maze_seed, "steps": steps, "seed": seed, "pretrain_maze": pretrain_maze,
+        "maze_seed": maze_seed, "steps": steps, "seed": seed, "mode": label, "pretrain_maze": pretrain_maze,
         "error_final": float(err[-1]), "error_pi_final": float(err_pi[-1]),
         "error_mean": float(err.mean()), "error_pi_mean": float(err_pi.mean()),
         "path_length": float(np.sum(np.hypot(*np.diff(tr.poses[:, :2], axis=0).T))),
@@ -215,14 +230,15 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
         "final_negative_elbo": float(res.losses[-1]) if len(res.losses) else None,
     }
     (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
-    _error_png(err, err_pi, out / "error.png")
-    save_maze_png(maze, out / "map.png", paths=[("true", tr.poses, "k"), ("DVBF-LM online", res.estimates, "tab:blue"),
+    _error_png(err, err_pi, out / "error.png", label)
+    save_maze_png(maze, out / "map.png", paths=[("true", tr.poses, "k"),
+                                                (f"DVBF-LM {label}", res.estimates, "tab:blue"),
                                                 ("path integration", pi, "tab:red")],
-                  particles=res.particles, title=f"maze {maze_seed}: online SLAM, {steps} steps")
+                  particles=res.particles, title=f"maze {maze_seed}: {label} SLAM, {steps} steps")
     return metrics
 
 
-def _error_png(err, err_pi, filename) -> None:
+def _error_png(err, err_pi, filename, label: str = "online") -> None:
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -230,7 +246,7 @@ def _error_png(err, err_pi, filename) -> None:
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     try:
-        ax.plot(err, label="DVBF-LM online SLAM", c="tab:blue")
+        ax.plot(err, label=f"DVBF-LM {label} SLAM", c="tab:blue")
         ax.plot(err_pi, label="path integration", c="tab:red")
         ax.set_xlabel("step")
         ax.set_ylabel("localisation error (maze side = 1)")
