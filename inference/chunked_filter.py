@@ -22,6 +22,14 @@ import jax.numpy as jnp
 from jax.scipy.special import logsumexp
 
 
+def categorical_resample(key: jax.Array, log_weights: jax.Array, num: int) -> jax.Array:
+    """``num`` independent draws of particle indices from normalised ``log_weights (K,)`` by inverse CDF
+    (O(K + num log K), unlike ``jax.random.categorical``'s Gumbel draw of a ``(num, K)`` array)."""
+    cdf = jnp.cumsum(jnp.exp(log_weights))
+    u = jax.random.uniform(key, (num,)) * cdf[-1]
+    return jnp.clip(jnp.searchsorted(cdf, u, side="right"), 0, log_weights.shape[0] - 1)
+
+
 class ChunkedOutput(NamedTuple):
     """Per step of :func:`chunked_filter`: weighted mean and std ``(T, D)``, ``n_keep`` particles
     ``(T, n_keep, D)`` drawn by weight (for the ELBO's cache) and the effective sample size ``(T,)``."""
@@ -78,7 +86,7 @@ def chunked_filter(key: jax.Array, particles: jax.Array, controls: jax.Array, ob
         k_res, k_jit, k_move, k_keep = jax.random.split(key_t, 4)
 
         def restart(_):
-            idx = jax.random.categorical(k_res, log_w, shape=(k,))
+            idx = categorical_resample(k_res, log_w, k)
             return z[idx] + jitter * jax.random.normal(k_jit, z.shape), log_w0
 
         z, log_w = jax.lax.cond(t % chunk == 0, restart, lambda _: (z, log_w), None)
@@ -88,7 +96,7 @@ def chunked_filter(key: jax.Array, particles: jax.Array, controls: jax.Array, ob
         w = jnp.exp(log_w)
         mean = jnp.sum(w[:, None] * z, 0)
         std = jnp.sqrt(jnp.maximum(jnp.sum(w[:, None] * (z - mean) ** 2, 0), 0.0))
-        kept = z[jax.random.categorical(k_keep, log_w, shape=(n_keep,))]
+        kept = z[categorical_resample(k_keep, log_w, n_keep)]
         return (z, log_w), (mean, std, kept, 1.0 / jnp.sum(w * w))
 
     steps = controls.shape[0]
