@@ -89,6 +89,52 @@ def mark_scan(grid: SensedGrid, robot_xy, points_xy) -> SensedGrid:
     return SensedGrid(cells, grid.origin, res)
 
 
+def mark_sweep(grid: SensedGrid, robot_xy, ends_xy, returns_xy=None) -> SensedGrid:
+    """Add one scan as the area it swept: the polygon of its beam end points ``ends_xy`` (n, 2),
+    in beam order, beams that returned nothing ending at the LiDAR's range, is free; the cells of
+    ``returns_xy`` (k, 2) are occupied (an occupied cell stays occupied). This is the area the
+    coverage of the studies counts as seen (``cogmap.metrics.scan_mask``), with no gaps between
+    diverging beams. The polygon is star-shaped around the robot, so a cell is inside when it
+    lies on the robot's side of the edge between the two end points whose beams bracket it.
+    """
+    robot_xy = np.asarray(robot_xy, dtype=float)[:2]
+    ends = np.asarray(ends_xy, dtype=float).reshape(-1, 2)
+    rets = np.zeros((0, 2)) if returns_xy is None else np.asarray(returns_xy, dtype=float).reshape(-1, 2)
+    grid = ensure(grid, np.vstack([robot_xy[None, :], ends, rets]))
+    cells = grid.cells.copy()
+    res = grid.resolution
+    if ends.shape[0] >= 3:
+        rel = ends - robot_xy
+        ang = np.arctan2(rel[:, 1], rel[:, 0])
+        order = np.argsort(ang, kind="stable")
+        rel, ang = rel[order], ang[order]
+        lo = to_cells(grid, robot_xy + rel.min(axis=0))
+        hi = to_cells(grid, robot_xy + rel.max(axis=0))
+        rr, cc = np.mgrid[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
+        p = grid.origin + (np.stack([cc, rr], axis=-1) + 0.5) * res - robot_xy  # cell centres
+        a = np.arctan2(p[..., 1], p[..., 0])
+        i = np.searchsorted(ang, a, side="right") - 1  # wedge [ang[i], ang[i + 1]), cyclic
+        i = np.where(i < 0, ang.size - 1, i)
+        e0, e1 = rel[i], rel[(i + 1) % ang.size]
+        edge = e1 - e0
+        # the cell centre on the robot's side of the edge e0 -> e1, or within half a cell of the edge
+        # itself (a cell the boundary passes through counts, as for a filled polygon)
+        cross_cell = edge[..., 0] * (p[..., 1] - e0[..., 1]) - edge[..., 1] * (p[..., 0] - e0[..., 0])
+        cross_robot = edge[..., 0] * (-e0[..., 1]) - edge[..., 1] * (-e0[..., 0])
+        t = np.clip(((p - e0) * edge).sum(axis=-1) / np.maximum((edge**2).sum(axis=-1), 1e-12), 0.0, 1.0)
+        near = np.hypot(*np.moveaxis(p - e0 - t[..., None] * edge, -1, 0)) <= 0.5 * res
+        inside = (cross_cell * cross_robot >= 0) | near
+        sub = cells[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
+        sub[inside & (sub == UNKNOWN)] = FREE
+    if rets.shape[0]:
+        hit = to_cells(grid, rets)
+        cells[hit[:, 0], hit[:, 1]] = OCCUPIED
+    here = to_cells(grid, robot_xy)
+    if cells[here[0], here[1]] == UNKNOWN:
+        cells[here[0], here[1]] = FREE
+    return SensedGrid(cells, grid.origin, res)
+
+
 def changed_bounds(before: SensedGrid, after: SensedGrid):
     """World box ``(xmin, ymin, xmax, ymax)`` of the cells whose value differs between two grids
     over the same cells (``after = mark_scan(ensure(before, ...), ...)``), or None."""
@@ -144,11 +190,15 @@ def opaque(grid: SensedGrid) -> np.ndarray:
     return grown
 
 
-def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3) -> np.ndarray:
+def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
+                free_path: float = np.inf) -> np.ndarray:
     """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
-    would sweep, treating unknown cells as transparent and occupied cells (grown by one cell,
-    :func:`opaque`) as opaque; cells outside the grid are unknown. Samples within ``skip`` of the
-    viewpoint (the robot's own footprint) neither count nor block."""
+    would sweep, with occupied cells (grown by one cell, :func:`opaque`) opaque; cells outside the
+    grid are unknown. Unknown cells are transparent by default; with a finite ``free_path`` (m)
+    each is occupied with a small independent chance, so a sample behind ``u`` metres of unknown
+    cells (itself included) counts ``exp(-u / free_path)``, the chance that nothing unknown hides
+    it. Samples within ``skip`` of the viewpoint (the robot's own footprint) neither count nor
+    block."""
     xy = np.atleast_2d(np.asarray(xy, dtype=float))
     if xy.shape[0] == 0:
         return np.zeros(0)
@@ -168,15 +218,22 @@ def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip:
     # a sample is visible while no opaque sample lies before it (or on it) on its ray
     blocked = np.cumsum(wall, axis=2) > 0
     seen = unknown & ~blocked
+    if np.isfinite(free_path):
+        hidden = np.cumsum(seen, axis=2) * grid.resolution  # unknown metres up to each sample
+        return (seen * np.exp(-hidden / free_path) * w[None, None, :]).sum(axis=(1, 2))
     return (seen * w[None, None, :]).sum(axis=(1, 2))
 
 
-def view_area(radius: float = 6.0, rays: int = 48, resolution: float = 0.2, skip: float = 0.3) -> float:
+def view_area(radius: float = 6.0, rays: int = 48, resolution: float = 0.2, skip: float = 0.3,
+              free_path: float = np.inf) -> float:
     """Area a view of :func:`unseen_area` stands for in an unknown, unobstructed plane (its
     largest value), used to turn unseen areas into fractions."""
     off, w = ray_offsets(radius, rays, resolution)
     near = (np.arange(off.shape[1]) + 1) * resolution <= skip
-    return float(rays * w[~near].sum())
+    weight = np.ones(w.size)
+    if np.isfinite(free_path):
+        weight = np.exp(-np.cumsum(~near) * resolution / free_path)
+    return float(rays * (w * weight)[~near].sum())
 
 
 def frontier_points(grid: SensedGrid, spacing: float = 1.0) -> np.ndarray:
@@ -204,25 +261,6 @@ def near_any(points, centres, radius: float) -> np.ndarray:
         return np.zeros(points.shape[0], dtype=bool)
     d, _ = cKDTree(centres).query(points, k=1, distance_upper_bound=radius * (1 + 1e-12))
     return np.isfinite(d)
-
-
-def best_target(gain, steps, step_length: float = 1.0, detour: float = 1.0, keep: int = -1,
-                keep_ratio: float = 1.0) -> int:
-    """Index of the target with the most information per metre, ``gain / (steps * step_length
-    + detour)`` (the oracle's rule); unreachable targets (infinite or negative steps) are never
-    chosen. The target ``keep`` (the one pursued so far) stays chosen while its score is at least
-    ``keep_ratio`` times the best, so the choice does not flip between near-equal targets.
-    Returns -1 when no target is reachable or none has positive gain."""
-    gain = np.asarray(gain, dtype=float)
-    steps = np.asarray(steps, dtype=float)
-    ok = np.isfinite(steps) & (steps >= 0) & (gain > 0)
-    if not ok.any():
-        return -1
-    score = np.where(ok, gain / (np.where(ok, steps, 0.0) * step_length + detour), -np.inf)
-    best = int(np.argmax(score))
-    if 0 <= keep < score.size and ok[keep] and score[keep] >= keep_ratio * score[best]:
-        return keep
-    return best
 
 
 def line_of_sight(grid: SensedGrid, a, b, grown: bool = False) -> np.ndarray:
@@ -280,16 +318,65 @@ def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.n
     order = np.argsort(src_idx, kind="stable")
     steps, _, which = dijkstra(graph, directed=False, indices=start[order], min_only=True,
                                return_predecessors=True, limit=max_dist / grid.resolution + 1e-9)
-    reached = np.isfinite(steps) & (which >= 0)
-    label = np.full(Hw * Ww, -1, dtype=np.int64)
     pos = np.full(Hw * Ww, -1, dtype=np.int64)
     pos[start[order]] = src_idx[order]
+    reached = np.isfinite(steps) & (which >= 0)
+    label = np.full(Hw * Ww, -1, dtype=np.int64)
     label[reached] = pos[which[reached]]
     dist = np.where(reached, steps * grid.resolution, np.inf)
     label, dist = label.reshape(Hw, Ww), dist.reshape(Hw, Ww)
     full_label[r0:r1, c0:c1] = label
     full_dist[r0:r1, c0:c1] = dist
     return full_label, full_dist
+
+
+def path_lengths(grid: SensedGrid, source_xy) -> np.ndarray:
+    """Per cell (the grid's shape), the length (m) of the shortest 8-connected path from
+    ``source_xy`` over sensed free cells that are not :func:`opaque` (:func:`geodesic_labels`
+    with one source and no length limit); inf where no such path exists."""
+    H, W = grid.cells.shape
+    return geodesic_labels(grid, np.asarray(source_xy, dtype=float).reshape(1, 2), (H + W) * grid.resolution)[1]
+
+
+def lookup_near(grid: SensedGrid, values: np.ndarray, xy, cells: int = 2) -> np.ndarray:
+    """The smallest of ``values`` (a per-cell array, e.g. :func:`path_lengths`) within ``cells``
+    cells of each point of ``xy`` (n, 2): the way to the neighbourhood of a point that itself lies
+    on a wall's fringe or on an unknown cell (a frontier point, a state beside furniture); inf
+    outside the grid."""
+    from scipy.ndimage import minimum_filter
+
+    return lookup(grid, minimum_filter(values, size=2 * cells + 1, mode="constant", cval=np.inf), xy, np.inf)
+
+
+def rank_viewpoints(gain, path, detour: float = 1.0, keep: int = -1, keep_ratio: float = 1.0) -> np.ndarray:
+    """Viewpoints in order of information per metre, ``gain / (path + detour)`` (the oracle's
+    rule), best first; viewpoints with no path (inf) or no gain are left out. The viewpoint
+    ``keep`` (the one pursued so far) comes first while its score is at least ``keep_ratio``
+    times the best, so the choice does not flip between near-equal viewpoints."""
+    gain = np.asarray(gain, dtype=float)
+    path = np.asarray(path, dtype=float)
+    ok = np.isfinite(path) & (path >= 0) & (gain > 0)
+    score = np.where(ok, gain / (np.where(ok, path, 0.0) + detour), -np.inf)
+    order = np.argsort(-score, kind="stable")
+    order = order[ok[order]]
+    if order.size and 0 <= keep < score.size and ok[keep] and score[keep] >= keep_ratio * score[order[0]]:
+        order = np.concatenate([[keep], order[order != keep]])
+    return order
+
+
+def state_toward(way_left, steps, step_length: float = 1.0, weight: float = 0.1) -> int:
+    """The state from which the rest of the way to a viewpoint is shortest: the index minimising
+    ``way_left + weight * steps * step_length`` (``way_left``: path length from each state to the
+    viewpoint; ``steps``: believed-possible steps to reach the state, inf when none), so the
+    nearest state to the viewpoint wins and the believed path breaks near-ties. -1 when no state
+    has both."""
+    steps = np.asarray(steps, dtype=float)
+    finite = np.isfinite(steps)
+    believed = weight * step_length * np.where(finite, steps, 0.0)
+    cost = np.asarray(way_left, dtype=float) + np.where(finite, believed, np.inf)
+    if cost.size == 0 or not np.isfinite(cost).any():
+        return -1
+    return int(np.argmin(cost))
 
 
 def lookup(grid: SensedGrid, values: np.ndarray, xy, fill):

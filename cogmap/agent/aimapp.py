@@ -70,6 +70,11 @@ class Sensed:
     scan : numpy.ndarray or None
         ``(n, 2)`` float LiDAR returns relative to the robot, metres, axes of the odometry frame;
         optional (None: no scan, only the obstacle flags).
+    sweep : numpy.ndarray or None
+        ``(beams, 2)`` float end point of every beam in beam order (a beam that returned nothing
+        ends at the LiDAR's range), relative to the robot, axes of the odometry frame: the area
+        the scan swept, for the agent's sensed grid; optional (None: the grid is drawn from the
+        returns' rays).
     """
 
     panorama: np.ndarray | None
@@ -77,6 +82,7 @@ class Sensed:
     odometry: np.ndarray | None  # (x, y, yaw) in the odometry frame
     moved: bool | None = None  # outcome of the last motion command (None: no command)
     scan: np.ndarray | None = None  # optional LiDAR returns relative to the robot (odometry frame, (n, 2))
+    sweep: np.ndarray | None = None  # optional end points of every beam (max range where nothing returned)
     # the agent turns panorama, obstacles and scan into its belief frame before using them
 
     @property
@@ -448,6 +454,7 @@ class AIMAPPAgent:
         if pano is not None and np.ndim(pano) >= 2:
             pano = to_frame_panorama(pano, yaw)
         scan = None if sensed.scan is None else rotate(self.frame, sensed.scan)
+        sweep = None if sensed.sweep is None else rotate(self.frame, sensed.sweep)
         if scan is not None:
             h = 2 * np.pi * np.arange(cfg.num_headings) / cfg.num_headings
             moves = cfg.influence_radius * np.stack([np.cos(h), np.sin(h)], axis=1)
@@ -457,7 +464,7 @@ class AIMAPPAgent:
             obstacles = np.roll(np.asarray(sensed.obstacles, dtype=bool), k)
         else:  # the LiDAR is silent
             obstacles = None
-        return Sensed(pano, obstacles, sensed.odometry, sensed.moved, scan)
+        return Sensed(pano, obstacles, sensed.odometry, sensed.moved, scan, sweep)
 
     def _correct(self, q: np.ndarray, conf: Confidence, local: Sensed, pose: np.ndarray) -> bool:
         """Drift correction (section 3.3): when the posterior confidently names a state that has

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import asdict, dataclass, field, fields
 
 from cogmap.inference.learning import LearningRates
@@ -130,7 +131,7 @@ class AgentConfig:
     view_resolution : float
         Metres: cell size of the agent's sensed grid.
     view_radius : float
-        Metres: range of the view imagined from a state.
+        Metres: range of the view imagined from a state or frontier point (the LiDAR's).
     view_rays : int
         Rays cast for an imagined view.
     view_min_area : float
@@ -143,13 +144,24 @@ class AgentConfig:
         Square metres that must be unseen from a frontier point for it to count.
     view_spent_radius : float
         Metres: a frontier point this close to a visited state is spent.
-    view_frontier_reach : float
-        Metres (geodesic): a frontier point counts for an unvisited state that sees it this close.
     view_detour : float
         Metres added to the path length when scoring a target as unseen area / (path + detour),
         as for the oracle baseline.
     view_keep_ratio : float
-        Keep pursuing the current target while its score is at least this fraction of the best.
+        Keep pursuing the current viewpoint while its score is at least this fraction of the best.
+    view_keep_radius : float
+        Metres: a viewpoint this close to the one pursued is taken for it.
+    view_path_weight : float
+        Metres of the rest of the way to a viewpoint that one metre of believed path to the
+        state preferred for it is worth (the state nearest the viewpoint wins; the believed path
+        breaks near-ties).
+    view_tries : int
+        Viewpoints considered, best first: when none of them is brought nearer by any state, no
+        viewpoint is pursued and the paper's terms alone decide (the map grows around the robot).
+    view_free_path : float
+        Metres: an imagined view counts an unknown cell behind ``u`` metres of unknown cells with
+        weight ``exp(-u / view_free_path)`` (unknown cells independently occupied; inf:
+        transparent).
     view_doubt_range : float
         Metres: believed transitions with both ends this close to the robot are checked against
         the latest scan.
@@ -207,15 +219,18 @@ class AgentConfig:
     # Exploration that knows what the LiDAR has sensed (docs/exploration.md); 0 weight: paper terms only
     view_weighting: bool = True  # weight the information gain by the unseen part of each state's view
     view_resolution: float = 0.2  # cell size of the agent's sensed grid (m)
-    view_radius: float = 6.0  # range of the imagined view from a state (m)
-    view_rays: int = 48
+    view_radius: float = 12.0  # range of the imagined view (m): the LiDAR's
+    view_rays: int = 72
+    view_free_path: float = 4.0  # m: unknown space hides what lies behind it, exp(-u / free path)
     view_min_area: float = 1.0  # m2 unseen: a state below this no longer promises information
     view_frontier_spacing: float = 1.0  # frontier points one per this square (m) when no state promises anything
     view_frontier_area: float = 4.0  # m2 unseen from a frontier point for it to count
-    view_spent_radius: float = 1.5  # a frontier point this close to a visited state is spent
-    view_frontier_reach: float = 6.0  # m: a frontier point counts for an unvisited state that sees it this close
+    view_spent_radius: float = 1.0  # a frontier point this close to a visited state is spent
     view_detour: float = 1.0  # m added to the path in unseen area / (path + detour), as for the oracle
-    view_keep_ratio: float = 0.7  # keep pursuing a target while its score is this close to the best
+    view_keep_ratio: float = 0.7  # keep pursuing a viewpoint while its score is this close to the best
+    view_keep_radius: float = 0.5  # m: a viewpoint this close to the pursued one is taken for it
+    view_path_weight: float = 0.1  # m of the way left per m of believed path to the state preferred for a view
+    view_tries: int = 8  # best viewpoints considered; none brought nearer: the paper's terms alone
     view_doubt_range: float = 4.0  # m: believed transitions this close are checked against the latest scan
     view_floor: float = 0.05  # smallest weight of a state's information gain
     explore_inductive_weight: float = 1.0  # inductive term toward states that still promise information
@@ -275,12 +290,18 @@ class AgentConfig:
             On a key that is not a field (of the config or of the learning rates).
         """
         d = dict(d)
+        for key in _RETIRED & set(d):  # settings of earlier versions that no longer change a run
+            warnings.warn(f"AgentConfig: field {key!r} is retired and ignored", stacklevel=2)
+            del d[key]
         _check_keys(cls, d)
         if isinstance(d.get("learning"), dict):
             lr = dict(d["learning"])
             _check_keys(LearningRates, lr)
             d["learning"] = LearningRates(**{k: tuple(v) if isinstance(v, list) else v for k, v in lr.items()})
         return cls(**d)
+
+
+_RETIRED = frozenset({"view_frontier_reach"})
 
 
 def _check_keys(cls, d: dict) -> None:

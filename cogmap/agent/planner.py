@@ -12,31 +12,56 @@ from cogmap.planning.decide import decide as mcts_decide
 from cogmap.planning.mcts import MCTSConfig
 
 
-def _target(agent, state: int, states: np.ndarray, gains: np.ndarray, beyond: np.ndarray) -> np.ndarray:
-    """The preferred state of the inductive term while exploring: among the states that still
-    promise information, the one with the most unseen area per metre of believed-possible path
-    from ``state`` (plus ``beyond``, the way from that state to the view that promises it).
-    Sources of believed transitions that the latest scan shows blocked count as candidates too
-    (worth ``view_min_area``). Empty when none is reachable within the inductive depth."""
-    cfg, B, n = agent.cfg, agent.model.B[0], agent.num_states
+def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
+    """The preferred state of the inductive term while exploring (docs/exploration.md).
+
+    Viewpoints are the informative unvisited states and frontier points (``ViewMap.viewpoints``),
+    plus the sources of believed transitions that the latest scan shows blocked (worth
+    ``view_min_area``). They are ranked by unseen area per metre of path from the robot over its
+    sensed free space (the oracle's rule, :func:`sensed.rank_viewpoints`, with hysteresis). For
+    the best ``view_tries`` of them in turn, the state with the shortest rest of the way to the
+    viewpoint (a metre of believed-possible path to that state counting ``view_path_weight``
+    metres, :func:`sensed.state_toward`) is preferred, so Eq. 9 pulls MCTS toward the viewpoint
+    from however far away. A viewpoint for which that state is the robot's own is set aside until
+    the map grows (the robot stands as near to it as the map allows), as the oracle's viewpoints
+    are once stood on. Empty when no viewpoint is left or none is brought nearer; then
+    ``views.unreached`` counts the viewpoints and the paper's terms alone decide."""
+    cfg, views, B, n = agent.cfg, agent.views, agent.model.B[0], agent.num_states
+    poses, visited = agent.poses[:n], agent.scanned_from()[:n].astype(bool)
+    xy, gains, _ = views.viewpoints(poses, visited, areas)
     src, dst = B.edges(cfg.inductive_threshold, n)
-    doubt = agent.views.doubtful(agent.poses, src, dst, state)
+    doubt = views.doubtful(poses, src, dst, state)
     if doubt.size:  # a believed transition crosses a newly sensed obstacle: its source has information
-        states = np.concatenate([states, doubt])
+        xy = np.vstack([xy, poses[doubt]])
         gains = np.concatenate([gains, np.full(doubt.size, cfg.view_min_area)])
-        beyond = np.concatenate([beyond, np.zeros(doubt.size)])
-    if states.size == 0:
-        agent.views.target, agent.views.unreached = -1, 0
-        return states
-    steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth)[states].astype(float)
+    views.target, views.unreached = -1, 0
+    if gains.size == 0:
+        views.viewpoint = None
+        return np.zeros(0, dtype=np.int64)
+    grid = views.grid
+    path = sensed.lookup_near(grid, sensed.path_lengths(grid, poses[state]), xy)
+    keep = -1
+    if views.viewpoint is not None:
+        d = np.hypot(*(xy - views.viewpoint).T)
+        keep = int(np.argmin(d)) if d.min() <= cfg.view_keep_radius else -1
+    order = sensed.rank_viewpoints(gains, path, cfg.view_detour, keep=keep, keep_ratio=cfg.view_keep_ratio)
+    steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth).astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
-    last = agent.views.target
-    keep = int(np.flatnonzero(states == last)[0]) if last >= 0 and (states == last).any() else -1
-    i = sensed.best_target(gains, steps + beyond / cfg.influence_radius, cfg.influence_radius, cfg.view_detour,
-                           keep=keep, keep_ratio=cfg.view_keep_ratio)
-    agent.views.target = int(states[i]) if i >= 0 else -1
-    agent.views.unreached = int(states.size) if i < 0 else 0  # informative states without a believed path
-    return states[i:i + 1] if i >= 0 else states[:0]
+    if views.spent_at != n:  # the map grew: a new state may bring the robot nearer to them
+        views.spent, views.spent_at = [], n
+    if views.spent:  # set-aside viewpoints do not use up the tries
+        order = order[~sensed.near_any(xy[order], np.asarray(views.spent), 0.3)]
+    for j in order[: cfg.view_tries]:
+        # the state with the shortest rest of the way to the viewpoint, a metre of believed path
+        # to it counting view_path_weight metres; none but the robot's own: set it aside
+        way = sensed.lookup_near(grid, sensed.path_lengths(grid, xy[j]), poses)
+        s = sensed.state_toward(way, steps, cfg.influence_radius, cfg.view_path_weight)
+        if s >= 0 and s != state:
+            views.viewpoint, views.target = xy[j].copy(), s
+            return np.array([s])
+        views.spent.append(xy[j].copy())
+    views.viewpoint, views.unreached = None, int(order.size)  # viewpoints with a path, none brought nearer
+    return np.zeros(0, dtype=np.int64)
 
 
 def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
@@ -57,8 +82,8 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
         objective, goal_states = efe.exploration(), None
         views, seen_from = agent.views, agent.scanned_from()
         areas = views.areas(agent.poses, seen_from) if cfg.view_weighting else None
-        if areas is not None:  # what the LiDAR has sensed weights the information gain; informative states pull
-            goal_states = _target(agent, state, *views.candidates(agent.poses, seen_from, areas))
+        if areas is not None:  # what the LiDAR has sensed weights the information gain; informative views pull
+            goal_states = _target(agent, state, areas)
             if goal_states.size:
                 objective = efe.sensed_exploration(inductive_weight=cfg.explore_inductive_weight)
                 view = views.fractions(areas)

@@ -9,19 +9,20 @@ from cogmap.harness import Command
 
 from .aimapp import AIMAPPAgent, Sensed
 from .config import AgentConfig
-from .sensing import corridor_obstacles, scan_points
+from .sensing import corridor_obstacles, scan_points, sweep_points
 
 
 def sense(sim, moved: bool | None, cfg: AgentConfig) -> Sensed:
     """Panorama, odometry and the corridor obstacle signal (odometry frame) from the robot."""
     ranges, odom = sim.lidar(), sim.odometry()
-    obstacles = points = None
+    obstacles = points = sweep = None
     if ranges is not None and odom is not None:
         angles = sim.lidar_angles() + odom[2]  # beams in the odometry frame
         obstacles = corridor_obstacles(ranges, angles, cfg.num_headings, cfg.influence_radius,
                                        cfg.robot_radius + cfg.obstacle_margin, sim.config.lidar_range)
         points = scan_points(ranges, angles, sim.config.lidar_range)
-    return Sensed(sim.panorama(), obstacles, odom, moved, points)
+        sweep = sweep_points(ranges, angles, sim.config.lidar_range)
+    return Sensed(sim.panorama(), obstacles, odom, moved, points, sweep)
 
 
 class AgentPolicy:

@@ -19,6 +19,14 @@ def scan_points(ranges: np.ndarray, beam_angles: np.ndarray, max_range: float = 
     return r[hit, None] * np.stack([np.cos(beam_angles[hit]), np.sin(beam_angles[hit])], axis=1)
 
 
+def sweep_points(ranges: np.ndarray, beam_angles: np.ndarray, max_range: float = 12.0) -> np.ndarray:
+    """End point of every beam relative to the robot (in the frame of ``beam_angles``), in beam
+    order: the return, or the point at ``max_range`` for a beam that hit nothing."""
+    r = np.asarray(ranges, dtype=float)
+    r = np.where(np.isfinite(r), np.minimum(r, max_range), max_range)
+    return r[:, None] * np.stack([np.cos(beam_angles), np.sin(beam_angles)], axis=1)
+
+
 def blocked(points: np.ndarray, moves: np.ndarray, half_width: float) -> np.ndarray:
     """For each move vector (relative to the robot), whether a return lies in its corridor."""
     moves = np.atleast_2d(np.asarray(moves, dtype=float))

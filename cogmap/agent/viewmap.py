@@ -26,7 +26,10 @@ class ViewMap:
         self.doubt: set[int] = set()  # states beside a moved obstacle, preferred until visited
         self.target = -1  # state pursued by the inductive term (kept while nearly the best)
         self.unreached = 0  # states that promise information but no believed-possible path reaches
-        self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution)
+        self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution, free_path=cfg.view_free_path)
+        self.viewpoint: np.ndarray | None = None  # the viewpoint pursued (its state is ``target``)
+        self.spent: list = []  # viewpoints pursued until no state brought the robot nearer (until the map grows)
+        self.spent_at = 0  # number of states when ``spent`` was started
 
     def observe(self, agent, sensed) -> None:
         """Add the scan of ``sensed`` (points relative to the robot, odometry frame) to the grid,
@@ -40,12 +43,20 @@ class ViewMap:
         # e.g. rigid, correction), applied to the returns
         ex = agent.believed_pose(odom + np.r_[1.0, 0.0, np.zeros(odom.size - 2)]) - robot
         ey = agent.believed_pose(odom + np.r_[0.0, 1.0, np.zeros(odom.size - 2)]) - robot
-        rel = np.asarray(scan, dtype=float).reshape(-1, 2)
-        pts = robot + rel[:, :1] * ex + rel[:, 1:] * ey
+        def belief(rel):
+            rel = np.asarray(rel, dtype=float).reshape(-1, 2)
+            return robot + rel[:, :1] * ex + rel[:, 1:] * ey
+
+        pts = belief(scan)
         if self.grid is None:
             self.grid = sg.empty(robot, self.cfg.view_resolution)
-        before = sg.ensure(self.grid, np.vstack([robot[None, :], pts]))
-        self.grid = sg.mark_scan(before, robot, pts)
+        if sensed.sweep is not None:  # the area the beams swept, as the coverage counts it
+            ends = belief(sensed.sweep)
+            before = sg.ensure(self.grid, np.vstack([robot[None, :], ends, pts]))
+            self.grid = sg.mark_sweep(before, robot, ends, pts)
+        else:  # returns only: the cells along their rays
+            before = sg.ensure(self.grid, np.vstack([robot[None, :], pts]))
+            self.grid = sg.mark_scan(before, robot, pts)
         self.robot, self.returns = robot, pts
         box = sg.changed_bounds(before, self.grid)  # views within reach of it must be recomputed
         self._dirty_states = sg.merge_boxes(self._dirty_states, box)
@@ -68,7 +79,7 @@ class ViewMap:
         self._dirty_states = None
         stale = np.flatnonzero(new | live)
         if stale.size:
-            self.area[stale] = sg.unseen_area(self.grid, poses[stale], self.cfg.view_radius, self.cfg.view_rays)
+            self.area[stale] = self._unseen(poses[stale])
         return self.area[:n]
 
     def doubtful(self, poses: np.ndarray, src: np.ndarray, dst: np.ndarray, state: int) -> np.ndarray:
@@ -94,45 +105,33 @@ class ViewMap:
                     self.doubt.update(int(s) for s in sources[seen])
         return np.array(sorted(self.doubt), dtype=np.int64)
 
-    def candidates(self, poses: np.ndarray, visited: np.ndarray,
+    def viewpoints(self, poses: np.ndarray, visited: np.ndarray,
                    areas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """States that still promise information, how much (m2), and how far (m) beyond the
-        state the view that promises it lies: the states whose own view would reveal at least
-        ``view_min_area`` (0 m beyond), and the unvisited states nearest (along sensed free
-        space) to a frontier point whose view would reveal ``view_frontier_area``, that no
-        visited state stands near (what is left unseen there is not visible from close by), within
-        ``view_frontier_reach`` (the map grows from that state toward the frontier)."""
+        """Where a view would still reveal something, and how much (m2): the unvisited states
+        whose own view would reveal at least ``view_min_area``, and the frontier points of the
+        sensed grid (free cells beside unknown ones, one per ``view_frontier_spacing`` square)
+        whose view would reveal ``view_frontier_area``, but not those within
+        ``view_spent_radius`` of a visited state (what is left unseen there is not visible from
+        close by). Returns the points (m, 2), their unseen areas and, per point, its state (-1
+        for a frontier point)."""
         cfg = self.cfg
         visited = np.asarray(visited[: len(poses)], dtype=bool)
-        states = np.flatnonzero(areas >= cfg.view_min_area)
-        gains, beyond = areas[states], np.zeros(states.size)
-        open_ = np.flatnonzero(~visited)
-        if self.grid is None or open_.size == 0:
-            return states, gains, beyond
+        states = np.flatnonzero((areas >= cfg.view_min_area) & ~visited)
+        xy, gains, which = poses[states], areas[states], states
+        if self.grid is None:
+            return xy, gains, which
         pts = sg.frontier_points(self.grid, cfg.view_frontier_spacing)
         pts = pts[~sg.near_any(pts, poses[visited], cfg.view_spent_radius)]
         if pts.shape[0] == 0:
-            return states, gains, beyond
+            return xy, gains, which
         fa = self._frontier_areas(pts)
         keep = fa >= cfg.view_frontier_area
-        pts, fa = pts[keep], fa[keep]
-        if pts.shape[0] == 0:
-            return states, gains, beyond
-        label, dist = sg.geodesic_labels(self.grid, pts, cfg.view_frontier_reach)
-        lab = sg.lookup(self.grid, label, poses[open_], -1)
-        far = sg.lookup(self.grid, dist, poses[open_], np.inf)
-        ok = lab >= 0
-        # per frontier point, the open state nearest to it
-        best = {}
-        for s, k, d in zip(open_[ok], lab[ok], far[ok], strict=True):
-            if k not in best or d < best[k][1]:
-                best[k] = (s, d)
-        if not best:
-            return states, gains, beyond
-        fs = np.array([v[0] for v in best.values()])
-        fd = np.array([v[1] for v in best.values()])
-        fg = fa[np.array(list(best.keys()))]
-        return np.concatenate([states, fs]), np.concatenate([gains, fg]), np.concatenate([beyond, fd])
+        return (np.vstack([xy, pts[keep]]), np.concatenate([gains, fa[keep]]),
+                np.concatenate([which, np.full(int(keep.sum()), -1)]))
+
+    def _unseen(self, xy: np.ndarray) -> np.ndarray:
+        cfg = self.cfg
+        return sg.unseen_area(self.grid, xy, cfg.view_radius, cfg.view_rays, free_path=cfg.view_free_path)
 
     def _frontier_areas(self, pts: np.ndarray) -> np.ndarray:
         """Unseen areas of frontier points, reusing those whose view no changed cell reaches."""
@@ -147,7 +146,7 @@ class ViewMap:
         self.frontier_cache = {k: self.frontier_cache[k] for k in keys if k in self.frontier_cache}
         todo = [i for i, k in enumerate(keys) if k not in self.frontier_cache]
         if todo:
-            fresh = sg.unseen_area(self.grid, pts[todo], cfg.view_radius, cfg.view_rays)
+            fresh = self._unseen(pts[todo])
             self.frontier_cache.update({keys[i]: float(a) for i, a in zip(todo, fresh, strict=True)})
         return np.array([self.frontier_cache[k] for k in keys])
 

@@ -98,3 +98,9 @@ def test_the_default_encoder_is_implicit_in_saved_configs():
     assert "encoder" not in AgentConfig().to_dict()
     assert AgentConfig.from_dict(AgentConfig().to_dict()).encoder == "ssim"
     assert AgentConfig(encoder="mine").to_dict()["encoder"] == "mine"
+
+
+def test_retired_fields_of_saved_configs_are_dropped_with_a_warning():
+    saved = AgentConfig().to_dict() | {"view_frontier_reach": 6.0}
+    with pytest.warns(UserWarning, match="'view_frontier_reach' is retired"):
+        assert AgentConfig.from_dict(saved) == AgentConfig()

@@ -123,14 +123,90 @@ def test_geodesic_labels_go_around_walls():
                                                                      sg.to_cells(room, [3.0, 1.0])[1]])
 
 
-def test_best_target_is_most_information_per_metre_and_keeps_near_ties():
-    gain = np.array([10.0, 30.0, 5.0, 50.0])
-    steps = np.array([1.0, 4.0, 0.0, np.inf])
-    # scores 10/2 = 5, 30/5 = 6, 5/1 = 5; the unreachable one is never chosen
-    assert sg.best_target(gain, steps) == 1
-    assert sg.best_target(gain, steps, keep=0, keep_ratio=0.8) == 0  # 5 >= 0.8 * 6
-    assert sg.best_target(gain, steps, keep=0, keep_ratio=0.9) == 1
-    assert sg.best_target(gain, np.full(4, np.inf)) == -1
+def test_rank_viewpoints_is_most_information_per_metre_and_keeps_near_ties():
+    gain = np.array([10.0, 30.0, 5.0, 50.0, 0.0])
+    path = np.array([1.0, 4.0, 0.0, np.inf, 0.5])
+    # scores 10/2 = 5, 30/5 = 6, 5/1 = 5; no path or no gain: left out; ties keep their order
+    assert sg.rank_viewpoints(gain, path).tolist() == [1, 0, 2]
+    assert sg.rank_viewpoints(gain, path, keep=0, keep_ratio=0.8).tolist() == [0, 1, 2]  # 5 >= 0.8 * 6
+    assert sg.rank_viewpoints(gain, path, keep=0, keep_ratio=0.9).tolist() == [1, 0, 2]
+    assert sg.rank_viewpoints(gain, path, keep=3, keep_ratio=0.0).tolist() == [1, 0, 2]  # no path: not kept
+    assert sg.rank_viewpoints(gain, np.full(5, np.inf)).size == 0
+    assert sg.rank_viewpoints(gain, path, detour=10.0).tolist() == [1, 0, 2]  # 30/14 > 10/11 > 5/10
+
+
+def test_state_toward_prefers_the_nearest_state_and_breaks_near_ties_by_believed_steps():
+    way = np.array([3.0, 1.0, 1.05, 0.5])
+    steps = np.array([0.0, 2.0, 1.0, np.inf])  # the nearest one has no believed path
+    assert sg.state_toward(way, steps, 1.0, 0.1) == 2  # 1.05 + 0.1 < 1.0 + 0.2
+    assert sg.state_toward(way, steps, 1.0, 0.0) == 1
+    assert sg.state_toward(way, steps, 2.0, 2.0) == 0  # a heavy path weight keeps the robot where it is
+    assert sg.state_toward(np.full(2, np.inf), np.zeros(2)) == -1
+
+
+def test_mark_sweep_fills_the_scan_polygon_like_the_coverage_count():
+    from cogmap.metrics import scan_mask
+
+    rng = np.random.default_rng(0)
+    a = np.arange(360) * 2 * np.pi / 360 + 0.3
+    r = np.clip(3.0 + 2.0 * np.sin(3 * a), 0.3, 12.0)  # a star-shaped room, 1-5 m
+    robot = np.array([0.4, -0.7])
+    ends = robot + r[:, None] * np.stack([np.cos(a), np.sin(a)], axis=1)
+    g = sg.mark_sweep(sg.empty(robot, 0.1), robot, ends, ends[::7])
+    # the filled polygon of the same end points (cv2.fillPoly, the studies' coverage rule) is the
+    # reference; they differ only on the boundary ring (fillPoly's vertices sit on cell corners)
+    ref = scan_mask(g.cells.shape, g.origin + g.resolution / 2, g.resolution, ends)
+    ours = g.cells != sg.UNKNOWN
+    assert (ours != ref).sum() <= 0.05 * ref.sum()
+    hit = sg.to_cells(g, ends[::7])
+    assert (g.cells[hit[:, 0], hit[:, 1]] == sg.OCCUPIED).all()
+    # beams that return nothing (ending at the range) still sweep free space, with no gaps
+    # between them far away; drawn from the returns alone (mark_scan) the open plane stays unknown
+    far = robot + 11.0 * np.stack([np.cos(a[::4]), np.sin(a[::4])], axis=1)  # 90 beams
+    open_plane = sg.mark_sweep(sg.empty(robot, 0.2), robot, far)
+    disc = np.hypot(*(sg.to_cells(open_plane, robot)[:, None, None] - np.indices(open_plane.cells.shape))) * 0.2
+    assert (open_plane.cells[disc < 10.5] == sg.FREE).all() and not (open_plane.cells == sg.OCCUPIED).any()
+    assert (sg.mark_scan(sg.empty(robot, 0.2), robot, np.zeros((0, 2))).cells == sg.FREE).sum() == 1
+    # an occupied cell stays occupied; unknown input of too few beams marks only the robot's cell
+    again = sg.mark_sweep(g, robot, ends)
+    assert (again.cells[hit[:, 0], hit[:, 1]] == sg.OCCUPIED).all()
+    two = sg.mark_sweep(sg.empty(robot, 0.1), robot, ends[:2])
+    assert (two.cells == sg.FREE).sum() == 1
+    del rng
+
+
+def test_unseen_area_through_unknown_space_decays_as_the_closed_form():
+    # an unknown plane, no walls: sum of exp(-u / L) dA over the disc of radius R, u = distance,
+    # = 2 pi L^2 (1 - exp(-R / L) (1 + R / L)); the samples stand for annular wedges of 0.05 m
+    L, R, res = 4.0, 12.0, 0.05
+    g = sg.empty((0.0, 0.0), res, 14.0)
+    closed = 2 * np.pi * L**2 * (1 - np.exp(-R / L) * (1 + R / L))
+    got = sg.unseen_area(g, [[0.0, 0.0]], R, 360, skip=0.0, free_path=L)[0]
+    assert abs(got - closed) <= 0.01 * closed
+    assert abs(sg.view_area(R, 360, res, skip=0.0, free_path=L) - got) <= 1e-9 * got
+    # with no free path limit it is the disc; a known free ring in front costs nothing
+    assert abs(sg.unseen_area(g, [[0.0, 0.0]], R, 360, skip=0.0)[0] - np.pi * R**2) <= 0.01 * np.pi * R**2
+    ring = g.cells.copy()
+    near = np.hypot(*(np.indices(ring.shape) - sg.to_cells(g, [0.0, 0.0])[:, None, None])) * res < 2.0
+    ring[near] = sg.FREE
+    seen_ring = sg.SensedGrid(ring, g.origin, res)
+    beyond = sg.unseen_area(seen_ring, [[0.0, 0.0]], R, 360, skip=0.0, free_path=L)[0]
+    a = 2.0  # unknown from 2 m on: 2 pi int_a^R r exp(-(r - a) / L) dr
+    shell = 2 * np.pi * (L * a + L**2 - np.exp(-(R - a) / L) * (L * R + L**2))
+    assert abs(beyond - shell) <= 0.02 * shell
+
+
+def test_path_lengths_go_around_walls_and_lookup_near_reads_beside_a_wall():
+    room = _room(4.0, 0.1)
+    wall = sg.to_cells(room, np.array([[2.0, 0.0], [2.0, 3.0]]))
+    room.cells[wall[0, 0]:wall[1, 0], wall[0, 1]] = sg.OCCUPIED  # wall at x = 2 from y = 0 to 3
+    dist = sg.path_lengths(room, [1.0, 1.0])
+    np.testing.assert_array_equal(dist, sg.geodesic_labels(room, [[1.0, 1.0]], 1e3)[1])
+    on_wall = np.array([[2.05, 1.0]])  # a point on the wall: not passable itself
+    assert np.isinf(sg.lookup(room, dist, on_wall, np.inf)[0])
+    near = sg.lookup_near(room, dist, on_wall, cells=2)[0]
+    assert 0.8 <= near <= 1.0  # the passable cell nearest to it on the robot's side
+    assert np.isinf(sg.lookup_near(room, dist, [[50.0, 50.0]])[0])  # outside the grid
 
 
 # -- the EFE term ----------------------------------------------------------------------------
