@@ -74,7 +74,7 @@ def draw(path=OUT, env: str = "house", seed: int = 0, steps: int = 120) -> Path:
     ax2.plot(x, cov, "k-", label="LiDAR coverage")
     no_target = np.array([r["target"] < 0 for r in rows])
     ax2.fill_between(x, 0, 1, where=no_target, color="0.85", step="mid",
-                     label="nothing reachable left unseen: paper terms only")
+                     label="no viewpoint pursued: paper terms only")
     ax2.axhline(0.9, color="tab:gray", ls="--", lw=0.8)
     ax2.set_ylim(0, 1.02)
     ax2.set_xlabel("decision")
