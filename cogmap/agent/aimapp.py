@@ -420,6 +420,7 @@ class AIMAPPAgent:
         expanded = self._update(q, conf, obs, local, pose, score)
         if self.frame is not frame:
             self._record_frame_move("relocalisation", pose, sensed.odometry)
+        self.views.blind = sensed.scan is None
         if not self.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
             self.views.observe(self, sensed)
             if conf.confident:

@@ -23,7 +23,8 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     viewpoint (a metre of believed-possible path to that state counting ``view_path_weight``
     metres, :func:`sensed.state_toward`) is preferred, so Eq. 9 pulls MCTS toward the viewpoint
     from however far away. A viewpoint for which that state is the robot's own is set aside until
-    the map grows (the robot stands as near to it as the map allows), as the oracle's viewpoints
+    a new state of the map lies nearer to it (the robot stands as near to it as the map allows;
+    nothing is set aside while the LiDAR is silent, since the map cannot grow then), as the oracle's viewpoints
     are once stood on. Empty when no viewpoint is left or none is brought nearer; then
     ``views.unreached`` counts the viewpoints and the paper's terms alone decide."""
     cfg, views, B, n = agent.cfg, agent.views, agent.model.B[0], agent.num_states
@@ -47,10 +48,12 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     order = sensed.rank_viewpoints(gains, path, cfg.view_detour, keep=keep, keep_ratio=cfg.view_keep_ratio)
     steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth).astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
-    if views.spent_at != n:  # the map grew: a new state may bring the robot nearer to them
-        views.spent, views.spent_at = [], n
+    if views.spent_at != n:  # the map changed: a viewpoint comes back when a new state lies nearer to it
+        views.spent = _revive(views.spent, poses[views.spent_at:n] if n > views.spent_at else None,
+                              cfg.view_keep_radius)
+        views.spent_at = n
     if views.spent:  # set-aside viewpoints do not use up the tries
-        order = order[~sensed.near_any(xy[order], np.asarray(views.spent), 0.3)]
+        order = order[~sensed.near_any(xy[order], np.array([p for p, _ in views.spent]), 0.3)]
     for j in order[: cfg.view_tries]:
         # the state with the shortest rest of the way to the viewpoint, a metre of believed path
         # to it counting view_path_weight metres; none but the robot's own: set it aside
@@ -59,9 +62,22 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
         if s >= 0 and s != state:
             views.viewpoint, views.target = xy[j].copy(), s
             return np.array([s])
-        views.spent.append(xy[j].copy())
+        if not views.blind:  # without the LiDAR the map cannot grow toward it: not a reason to give up
+            views.spent.append((xy[j].copy(), float(np.hypot(*(poses - xy[j]).T).min())))
     views.viewpoint, views.unreached = None, int(order.size)  # viewpoints with a path, none brought nearer
     return np.zeros(0, dtype=np.int64)
+
+
+def _revive(spent: list, new_poses, margin: float) -> list:
+    """The set-aside viewpoints ``(xy, distance of the nearest state then)`` that stay set aside
+    after the map changed: all of them are revived when states were removed (``new_poses`` None),
+    and one is revived when a new state lies more than ``margin`` nearer to it than any state did
+    (so the robot can now stand nearer), not merely because the map grew elsewhere."""
+    if new_poses is None:
+        return []
+    if len(new_poses) == 0:
+        return spent
+    return [(p, near) for p, near in spent if np.hypot(*(new_poses - p).T).min() >= near - margin]
 
 
 def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:

@@ -28,8 +28,9 @@ class ViewMap:
         self.unreached = 0  # states that promise information but no believed-possible path reaches
         self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution, free_path=cfg.view_free_path)
         self.viewpoint: np.ndarray | None = None  # the viewpoint pursued (its state is ``target``)
-        self.spent: list = []  # viewpoints pursued until no state brought the robot nearer (until the map grows)
+        self.spent: list = []  # (viewpoint, nearest state distance) set aside until a new state lies nearer
         self.spent_at = 0  # number of states when ``spent`` was started
+        self.blind = False  # the LiDAR is silent at this step: the map cannot grow, nothing is set aside
 
     def observe(self, agent, sensed) -> None:
         """Add the scan of ``sensed`` (points relative to the robot, odometry frame) to the grid,
