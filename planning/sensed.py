@@ -81,12 +81,19 @@ def mark_scan(grid: SensedGrid, robot_xy, points_xy) -> SensedGrid:
         samples = robot_xy + unit[:, None, :] * t[None, :, None]
         rc = to_cells(grid, samples[ok])
         cells[rc[:, 0], rc[:, 1]] = np.maximum(cells[rc[:, 0], rc[:, 1]], FREE)
-        hit = to_cells(grid, pts)
+    return _returns_and_robot(grid, cells, robot_xy, pts)
+
+
+def _returns_and_robot(grid: SensedGrid, cells: np.ndarray, robot_xy, returns_xy) -> SensedGrid:
+    """Finish a scan on ``cells`` (a copy of ``grid.cells``): the returns' cells occupied, the
+    robot's own cell free if it was unknown."""
+    if returns_xy.shape[0]:
+        hit = to_cells(grid, returns_xy)
         cells[hit[:, 0], hit[:, 1]] = OCCUPIED
     here = to_cells(grid, robot_xy)
     if cells[here[0], here[1]] == UNKNOWN:
         cells[here[0], here[1]] = FREE
-    return SensedGrid(cells, grid.origin, res)
+    return SensedGrid(cells, grid.origin, grid.resolution)
 
 
 def mark_sweep(grid: SensedGrid, robot_xy, ends_xy, returns_xy=None) -> SensedGrid:
@@ -115,24 +122,18 @@ def mark_sweep(grid: SensedGrid, robot_xy, ends_xy, returns_xy=None) -> SensedGr
         a = np.arctan2(p[..., 1], p[..., 0])
         i = np.searchsorted(ang, a, side="right") - 1  # wedge [ang[i], ang[i + 1]), cyclic
         i = np.where(i < 0, ang.size - 1, i)
-        e0, e1 = rel[i], rel[(i + 1) % ang.size]
-        edge = e1 - e0
+        wedge = np.roll(rel, -1, axis=0) - rel  # edge from each end point to the next
+        side = wedge[:, 0] * (-rel[:, 1]) - wedge[:, 1] * (-rel[:, 0])  # the robot's side of each edge
+        e0, edge, cross_robot = rel[i], wedge[i], side[i]
         # the cell centre on the robot's side of the edge e0 -> e1, or within half a cell of the edge
         # itself (a cell the boundary passes through counts, as for a filled polygon)
         cross_cell = edge[..., 0] * (p[..., 1] - e0[..., 1]) - edge[..., 1] * (p[..., 0] - e0[..., 0])
-        cross_robot = edge[..., 0] * (-e0[..., 1]) - edge[..., 1] * (-e0[..., 0])
         t = np.clip(((p - e0) * edge).sum(axis=-1) / np.maximum((edge**2).sum(axis=-1), 1e-12), 0.0, 1.0)
         near = np.hypot(*np.moveaxis(p - e0 - t[..., None] * edge, -1, 0)) <= 0.5 * res
         inside = (cross_cell * cross_robot >= 0) | near
         sub = cells[lo[0]:hi[0] + 1, lo[1]:hi[1] + 1]
         sub[inside & (sub == UNKNOWN)] = FREE
-    if rets.shape[0]:
-        hit = to_cells(grid, rets)
-        cells[hit[:, 0], hit[:, 1]] = OCCUPIED
-    here = to_cells(grid, robot_xy)
-    if cells[here[0], here[1]] == UNKNOWN:
-        cells[here[0], here[1]] = FREE
-    return SensedGrid(cells, grid.origin, res)
+    return _returns_and_robot(grid, cells, robot_xy, rets)
 
 
 def changed_bounds(before: SensedGrid, after: SensedGrid):
@@ -318,10 +319,10 @@ def geodesic_labels(grid: SensedGrid, sources_xy, max_dist: float) -> tuple[np.n
     order = np.argsort(src_idx, kind="stable")
     steps, _, which = dijkstra(graph, directed=False, indices=start[order], min_only=True,
                                return_predecessors=True, limit=max_dist / grid.resolution + 1e-9)
-    pos = np.full(Hw * Ww, -1, dtype=np.int64)
-    pos[start[order]] = src_idx[order]
     reached = np.isfinite(steps) & (which >= 0)
     label = np.full(Hw * Ww, -1, dtype=np.int64)
+    pos = np.full(Hw * Ww, -1, dtype=np.int64)
+    pos[start[order]] = src_idx[order]
     label[reached] = pos[which[reached]]
     dist = np.where(reached, steps * grid.resolution, np.inf)
     label, dist = label.reshape(Hw, Ww), dist.reshape(Hw, Ww)

@@ -29,7 +29,7 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     ``views.unreached`` counts the viewpoints and the paper's terms alone decide."""
     cfg, views, B, n = agent.cfg, agent.views, agent.model.B[0], agent.num_states
     poses, visited = agent.poses[:n], agent.scanned_from()[:n].astype(bool)
-    xy, gains, _ = views.viewpoints(poses, visited, areas)
+    xy, gains = views.viewpoints(poses, visited, areas)
     src, dst = B.edges(cfg.inductive_threshold, n)
     doubt = views.doubtful(poses, src, dst, state)
     if doubt.size:  # a believed transition crosses a newly sensed obstacle: its source has information

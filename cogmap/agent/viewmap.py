@@ -107,28 +107,26 @@ class ViewMap:
         return np.array(sorted(self.doubt), dtype=np.int64)
 
     def viewpoints(self, poses: np.ndarray, visited: np.ndarray,
-                   areas: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   areas: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Where a view would still reveal something, and how much (m2): the unvisited states
         whose own view would reveal at least ``view_min_area``, and the frontier points of the
         sensed grid (free cells beside unknown ones, one per ``view_frontier_spacing`` square)
         whose view would reveal ``view_frontier_area``, but not those within
         ``view_spent_radius`` of a visited state (what is left unseen there is not visible from
-        close by). Returns the points (m, 2), their unseen areas and, per point, its state (-1
-        for a frontier point)."""
+        close by). Returns the points (m, 2) and their unseen areas."""
         cfg = self.cfg
         visited = np.asarray(visited[: len(poses)], dtype=bool)
         states = np.flatnonzero((areas >= cfg.view_min_area) & ~visited)
-        xy, gains, which = poses[states], areas[states], states
+        xy, gains = poses[states], areas[states]
         if self.grid is None:
-            return xy, gains, which
+            return xy, gains
         pts = sg.frontier_points(self.grid, cfg.view_frontier_spacing)
         pts = pts[~sg.near_any(pts, poses[visited], cfg.view_spent_radius)]
         if pts.shape[0] == 0:
-            return xy, gains, which
+            return xy, gains
         fa = self._frontier_areas(pts)
         keep = fa >= cfg.view_frontier_area
-        return (np.vstack([xy, pts[keep]]), np.concatenate([gains, fa[keep]]),
-                np.concatenate([which, np.full(int(keep.sum()), -1)]))
+        return np.vstack([xy, pts[keep]]), np.concatenate([gains, fa[keep]])
 
     def _unseen(self, xy: np.ndarray) -> np.ndarray:
         cfg = self.cfg
