@@ -147,7 +147,6 @@ def test_state_toward_prefers_the_nearest_state_and_breaks_near_ties_by_believed
 def test_mark_sweep_fills_the_scan_polygon_like_the_coverage_count():
     from cogmap.metrics import scan_mask
 
-    rng = np.random.default_rng(0)
     a = np.arange(360) * 2 * np.pi / 360 + 0.3
     r = np.clip(3.0 + 2.0 * np.sin(3 * a), 0.3, 12.0)  # a star-shaped room, 1-5 m
     robot = np.array([0.4, -0.7])
@@ -172,7 +171,6 @@ def test_mark_sweep_fills_the_scan_polygon_like_the_coverage_count():
     assert (again.cells[hit[:, 0], hit[:, 1]] == sg.OCCUPIED).all()
     two = sg.mark_sweep(sg.empty(robot, 0.1), robot, ends[:2])
     assert (two.cells == sg.FREE).sum() == 1
-    del rng
 
 
 def test_unseen_area_through_unknown_space_decays_as_the_closed_form():
