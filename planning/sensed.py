@@ -191,6 +191,13 @@ def opaque(grid: SensedGrid) -> np.ndarray:
     return grown
 
 
+def _view_codes(grid: SensedGrid) -> np.ndarray:
+    """Per cell, padded by a ring of unknown cells (cells outside the grid are unknown and
+    transparent): bit 1 unknown, bit 2 :func:`opaque`."""
+    codes = (grid.cells == UNKNOWN).astype(np.uint8) | (opaque(grid).astype(np.uint8) << 1)
+    return np.pad(codes, 1, constant_values=1)
+
+
 def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
                 free_path: float = np.inf) -> np.ndarray:
     """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
@@ -204,15 +211,11 @@ def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip:
     if xy.shape[0] == 0:
         return np.zeros(0)
     off, w = ray_offsets(radius, rays, grid.resolution)
-    pts = xy[:, None, None, :] + off[None]  # (n, rays, samples, 2)
-    rc = to_cells(grid, pts)
-    H, W = grid.cells.shape
-    inside = (rc[..., 0] >= 0) & (rc[..., 0] < H) & (rc[..., 1] >= 0) & (rc[..., 1] < W)
-    unknown = np.ones(rc.shape[:-1], dtype=bool)
-    wall = np.zeros(rc.shape[:-1], dtype=bool)
-    r, c = rc[..., 0][inside], rc[..., 1][inside]
-    unknown[inside] = grid.cells[r, c] == UNKNOWN
-    wall[inside] = opaque(grid)[r, c]
+    rc = to_cells(grid, xy[:, None, None, :] + off[None])  # (n, rays, samples, 2)
+    codes = _view_codes(grid)  # one gather: the padding ring stands for every cell outside the grid
+    code = codes[np.clip(rc[..., 0] + 1, 0, codes.shape[0] - 1), np.clip(rc[..., 1] + 1, 0, codes.shape[1] - 1)]
+    unknown = (code & 1).astype(bool)
+    wall = (code & 2).astype(bool)
     near = (np.arange(off.shape[1]) + 1) * grid.resolution <= skip
     unknown[:, :, near] = False
     wall[:, :, near] = False
