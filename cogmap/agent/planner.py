@@ -84,9 +84,7 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     """Return (control, summary) for the agent's current belief ``agent.q``."""
     cfg, model = agent.cfg, agent.model
     n = model.num_states[0]
-    # The stay control never collides, but standing still gains nothing while exploring (MCTS
-    # would value it like the best move after it): it is offered in goal mode only.
-    obstacles = np.append(np.asarray(obstacles, dtype=bool), mode != "goal")
+    obstacles = np.asarray(obstacles, dtype=bool)
     mcfg = MCTSConfig(depth=cfg.mcts_depth, simulations=cfg.mcts_simulations, gamma=cfg.gamma,
                       move_threshold=cfg.min_move_probability, count_information_once=cfg.mcts_count_information_once,
                       discount=cfg.mcts_discount)
@@ -104,6 +102,13 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
                 objective = efe.sensed_exploration(inductive_weight=cfg.explore_inductive_weight)
                 view = views.fractions(areas)
             # else: nothing reachable is left unseen; the paper's terms alone (the model still learns)
+    # The stay control never collides, but standing still gains nothing while exploring, nor in goal
+    # mode away from a goal state: its subtree holds every move one step later, so with few
+    # simulations MCTS can value it like the best move after it and the robot waits for good
+    # (observed: 60 decisions in place). It is offered in goal mode at a goal state, or when no
+    # move is free.
+    at_goal = mode == "goal" and (bool(np.isin(state, goal_states)) or obstacles.all())
+    obstacles = np.append(obstacles, not at_goal)
     arrays = from_model(model, goal_states=goal_states, view=view, collision_pref=cfg.collision_preference)
     d = mcts_decide(arrays, [agent.q[:n]], obstacles, objective, config=mcfg, rng=agent.rng)
     out = {"actions": d.actions, "Q": d.Q, "visits": d.visits, "objective": objective, "arrays": arrays,

@@ -220,3 +220,33 @@ def test_house_exploration_ends_once_its_own_sensed_map_has_nothing_left_to_see(
     result = explore("house", steps=300, seed=1, progress=False, patience=20)
     assert result["ended_by_agent"] and result["steps"] < 150  # it used to walk all 300 decisions
     assert result["coverage"] >= 0.95
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_goals_are_reached_after_a_short_exploration_of_the_mini_warehouse(seed):
+    # The mini warehouse is sensed within 6-10 decisions, so the goals lie 4-5 believed steps away
+    # from the start. Offered away from a goal state, "stay" won MCTS's visits there (its subtree
+    # holds every move a step later) and the robot waited in place for all 60 decisions.
+    import copy
+
+    from cogmap.goal import pursue
+    from cogmap.study.runs import _choose_goals, explore_episode, study_sim
+
+    sim, _, explored, _ = explore_episode("mini_warehouse", "aimapp", seed, 60)
+    sim.close()
+    cfg = default_config("mini_warehouse")
+    sim = study_sim("mini_warehouse", cfg, seed)
+    start = explored.localise_at(sim.odometry())
+    goals = _choose_goals(explored, start, 2, 1.5)
+    sim.close()
+    assert len(goals) == 2
+    for k, (obs, _) in enumerate(goals):  # each goal from the start, as in the goals study
+        agent = copy.deepcopy(explored)
+        agent.rng = np.random.default_rng([seed, k])
+        sim = study_sim("mini_warehouse", cfg, seed)
+        try:
+            agent.localise_at(sim.odometry())
+            _, summary = pursue(sim, agent, obs, 60, progress=False)
+        finally:
+            sim.close()
+        assert summary["reached"] and summary["steps"] <= 15, (k, summary)
