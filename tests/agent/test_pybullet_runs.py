@@ -227,26 +227,11 @@ def test_goals_are_reached_after_a_short_exploration_of_the_mini_warehouse(seed)
     # The mini warehouse is sensed within 6-10 decisions, so the goals lie 4-5 believed steps away
     # from the start. Offered away from a goal state, "stay" won MCTS's visits there (its subtree
     # holds every move a step later) and the robot waited in place for all 60 decisions.
-    import copy
-
-    from cogmap.goal import pursue
-    from cogmap.study.runs import _choose_goals, explore_episode, study_sim
+    from cogmap.study.runs import explore_episode, goal_runs
 
     sim, _, explored, _ = explore_episode("mini_warehouse", "aimapp", seed, 60)
     sim.close()
-    cfg = default_config("mini_warehouse")
-    sim = study_sim("mini_warehouse", cfg, seed)
-    start = explored.localise_at(sim.odometry())
-    goals = _choose_goals(explored, start, 2, 1.5)
-    sim.close()
-    assert len(goals) == 2
-    for k, (obs, _) in enumerate(goals):  # each goal from the start, as in the goals study
-        agent = copy.deepcopy(explored)
-        agent.rng = np.random.default_rng([seed, k])
-        sim = study_sim("mini_warehouse", cfg, seed)
-        try:
-            agent.localise_at(sim.odometry())
-            _, summary = pursue(sim, agent, obs, 60, progress=False)
-        finally:
-            sim.close()
-        assert summary["reached"] and summary["steps"] <= 15, (k, summary)
+    params = {"goals_per_run": 2, "goal_steps": 60, "min_goal_distance": 1.5}  # the goals study's
+    results = goal_runs({"env": "mini_warehouse", "seed": seed}, explored, params)
+    assert len(results) == 2
+    assert all(r["reached"] and r["steps"] <= 15 for r in results), results
