@@ -198,20 +198,23 @@ def _view_codes(grid: SensedGrid) -> np.ndarray:
     return np.pad(codes, 1, constant_values=1)
 
 
-def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
-                free_path: float = np.inf) -> np.ndarray:
-    """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
-    would sweep, with occupied cells (grown by one cell, :func:`opaque`) opaque; cells outside the
-    grid are unknown. Unknown cells are transparent by default; with a finite ``free_path`` (m)
-    each is occupied with a small independent chance, so a sample behind ``u`` metres of unknown
-    cells (itself included) counts ``exp(-u / free_path)``, the chance that nothing unknown hides
-    it. Samples within ``skip`` of the viewpoint (the robot's own footprint) neither count nor
-    block."""
+def view_weights(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
+                 free_path: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+    """The samples of the imagined views from the viewpoints ``xy`` (n, 2) and the unknown area
+    (m2) each stands for (:func:`unseen_area` is their sum per viewpoint; a sample that is not
+    unknown, or not visible, weighs 0).
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (n, rays, samples, 2)
+        World positions of the samples.
+    weights : numpy.ndarray, shape (n, rays, samples)
+        Unseen area per sample (m2), visibility and ``free_path`` included.
+    """
     xy = np.atleast_2d(np.asarray(xy, dtype=float))
-    if xy.shape[0] == 0:
-        return np.zeros(0)
     off, w = ray_offsets(radius, rays, grid.resolution)
-    rc = to_cells(grid, xy[:, None, None, :] + off[None])  # (n, rays, samples, 2)
+    points = xy[:, None, None, :] + off[None]
+    rc = to_cells(grid, points)  # (n, rays, samples, 2)
     codes = _view_codes(grid)  # one gather: the padding ring stands for every cell outside the grid
     code = codes[np.clip(rc[..., 0] + 1, 0, codes.shape[0] - 1), np.clip(rc[..., 1] + 1, 0, codes.shape[1] - 1)]
     unknown = (code & 1).astype(bool)
@@ -224,8 +227,23 @@ def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip:
     seen = unknown & ~blocked
     if np.isfinite(free_path):
         hidden = np.cumsum(seen, axis=2) * grid.resolution  # unknown metres up to each sample
-        return (seen * np.exp(-hidden / free_path) * w[None, None, :]).sum(axis=(1, 2))
-    return (seen * w[None, None, :]).sum(axis=(1, 2))
+        return points, seen * np.exp(-hidden / free_path) * w[None, None, :]
+    return points, seen * w[None, None, :]
+
+
+def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
+                free_path: float = np.inf) -> np.ndarray:
+    """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
+    would sweep, with occupied cells (grown by one cell, :func:`opaque`) opaque; cells outside the
+    grid are unknown. Unknown cells are transparent by default; with a finite ``free_path`` (m)
+    each is occupied with a small independent chance, so a sample behind ``u`` metres of unknown
+    cells (itself included) counts ``exp(-u / free_path)``, the chance that nothing unknown hides
+    it. Samples within ``skip`` of the viewpoint (the robot's own footprint) neither count nor
+    block. Where that area lies: :func:`view_weights`."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=float))
+    if xy.shape[0] == 0:
+        return np.zeros(0)
+    return view_weights(grid, xy, radius, rays, skip, free_path)[1].sum(axis=(1, 2))
 
 
 def view_area(radius: float = 6.0, rays: int = 48, resolution: float = 0.2, skip: float = 0.3,

@@ -85,6 +85,28 @@ def test_unseen_area_behind_an_opening_is_the_wedge_through_it():
     assert 3 * across < far < 0.5 * np.pi * (5.0**2 - 0.5**2)
 
 
+def test_view_weights_lie_beyond_the_doorway_and_add_up_to_the_unseen_area():
+    room = _room(4.0, 0.1)
+    door = sg.to_cells(room, np.array([[4.05, 1.55], [4.05, 2.45]]))
+    room.cells[door[0, 0]:door[1, 0] + 1, door[0, 1]] = sg.FREE
+    xy = np.array([[0.5, 2.0], [3.5, 2.0]])
+    for free_path in (np.inf, 2.0):
+        points, weights = sg.view_weights(room, xy, 5.0, 180, free_path=free_path)
+        assert points.shape[:3] == weights.shape and points.shape[0] == 2 and points.shape[-1] == 2
+        np.testing.assert_allclose(weights.sum(axis=(1, 2)), sg.unseen_area(room, xy, 5.0, 180, free_path=free_path))
+        w = weights > 0
+        # every sample that counts lies east of the wall, in the band the doorway (grown by one
+        # cell) lets through, widening with distance from the viewpoint
+        assert (points[..., 0][w] > 4.0).all()
+        ys = points[0, ..., 1][w[0]]
+        assert 1.0 < ys.min() and ys.max() < 3.0
+    # with a finite free path, a sample behind more unknown counts less (exp(-u / free_path))
+    _, fin = sg.view_weights(room, xy[1:], 5.0, 180, free_path=2.0)
+    _, inf = sg.view_weights(room, xy[1:], 5.0, 180)
+    ratio = fin[inf > 0] / inf[inf > 0]
+    assert ((ratio > 0) & (ratio < 1)).all()
+
+
 def test_frontier_points_lie_on_the_edge_of_the_known():
     g = sg.empty((0.0, 0.0), 0.1, 3.0)
     g = sg.mark_scan(g, (0.0, 0.0), np.array([[2.0, 0.0]]))
