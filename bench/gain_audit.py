@@ -58,14 +58,15 @@ def audit_run(env: str, seed: int, steps: int) -> list[dict]:
     agent = AIMAPPAgent(aimapp_config("aimapp", env), seed=seed)
     cfg, grid = agent.cfg, sim.grid
     reachable = grid.reachable(sim.true_pose()[:2])
-    rows, last = [], [None]
+    rows, last = [], None
 
-    def on_step(_decision):
+    def on_step(_decision):  # after the planning call, before the move
+        nonlocal last
         views = agent.views
         v = views.viewpoint
-        if v is None or (last[0] is not None and np.hypot(*(v - last[0])) <= cfg.view_keep_radius):
+        if v is None or (last is not None and np.hypot(*(v - last)) <= cfg.view_keep_radius):
             return
-        last[0] = v.copy()
+        last = v.copy()
         seen = coverage_tracker(sim).seen
         points, weights = sensed.view_weights(views.grid, v, cfg.view_radius, cfg.view_rays,
                                               free_path=cfg.view_free_path)
