@@ -12,9 +12,9 @@ sample of the imagined view:
 * **occupied**: a wall, shelf or piece of furniture;
 * **outside**: neither (beyond the outer walls, or free space the robot cannot reach).
 
-It also prints the area a true 180-ray view from the viewpoint would add (the oracle's gain).
-The oracle ranks the same viewpoints with the true gain; the gap between the two columns is the
-agent's lack of the map, not a difference of rule.
+It also prints the area a true 180-ray view from the viewpoint would add: the gain the oracle
+ranks its own viewpoints by, with the same rule (gain per metre of path). The gap between the
+imagined and the true columns is what the agent does not know of the map.
 
     python bench/gain_audit.py [--envs small_warehouse aisle_warehouse] [--seeds 0 1 2 3 4]
 """
