@@ -33,11 +33,9 @@ KINDS = ("new", "seen", "occupied", "outside")
 
 def split(weights, points, grid, reachable, seen) -> dict:
     """Imagined area (m2) by what the true grid holds at each sample (``KINDS``)."""
-    cols = np.floor((points[..., 0] - grid.origin[0]) / grid.resolution).astype(int)
-    rows = np.floor((points[..., 1] - grid.origin[1]) / grid.resolution).astype(int)
-    H, W = grid.occupied.shape
-    inside = (rows >= 0) & (rows < H) & (cols >= 0) & (cols < W)
-    r, c = np.clip(rows, 0, H - 1), np.clip(cols, 0, W - 1)
+    rc = grid.world_to_cell(points)
+    inside = grid.in_bounds(rc)
+    r, c = np.clip(rc[..., 0], 0, grid.shape[0] - 1), np.clip(rc[..., 1], 0, grid.shape[1] - 1)
     free = inside & reachable[r, c]
     occupied = inside & grid.occupied[r, c]
     masks = {"new": free & ~seen[r, c], "seen": free & seen[r, c], "occupied": occupied,
@@ -46,28 +44,23 @@ def split(weights, points, grid, reachable, seen) -> dict:
 
 
 def audit_run(env: str, seed: int, steps: int) -> list[dict]:
-    """One AIMAPP run of the exploration study; a row per viewpoint it took up."""
-    from cogmap.agent.aimapp import AIMAPPAgent
+    """One AIMAPP run of the exploration study (``explore_episode``); a row per viewpoint it took up."""
     from cogmap.baselines.oracle import visible_mask
-    from cogmap.explore import Done, coverage_tracker, default_config, run_agent
+    from cogmap.explore import coverage_tracker
     from cogmap.planning import sensed
-    from cogmap.study.config import AIMAPP_END_RULE, AIMAPP_PATIENCE, aimapp_config
-    from cogmap.study.runs import study_sim
+    from cogmap.study.runs import explore_episode
 
-    sim = study_sim(env, default_config(env), seed, None)
-    agent = AIMAPPAgent(aimapp_config("aimapp", env), seed=seed)
-    cfg, grid = agent.cfg, sim.grid
-    reachable = grid.reachable(sim.true_pose()[:2])
     rows, last = [], None
 
-    def on_step(_decision):  # after the planning call, before the move
+    def on_step(sim, agent):  # after the planning call, before the move
         nonlocal last
-        views = agent.views
+        cfg, views, grid = agent.cfg, agent.views, sim.grid
         v = views.viewpoint
         if v is None or (last is not None and np.hypot(*(v - last)) <= cfg.view_keep_radius):
             return
         last = v.copy()
-        seen = coverage_tracker(sim).seen
+        tracker = coverage_tracker(sim)
+        seen, reachable = tracker.seen, tracker.free  # free: reachable from the run's start
         points, weights = sensed.view_weights(views.grid, v, cfg.view_radius, cfg.view_rays,
                                               free_path=cfg.view_free_path)
         row = split(weights[0], points[0], grid, reachable, seen)
@@ -76,11 +69,8 @@ def audit_run(env: str, seed: int, steps: int) -> list[dict]:
         row["imagined"] = float(weights.sum())
         rows.append(row)
 
-    try:
-        run_agent(sim, agent, steps, progress=False, on_step=on_step,
-                  stop=Done(agent, AIMAPP_PATIENCE, AIMAPP_END_RULE))
-    finally:
-        sim.close()
+    sim, _, _, _ = explore_episode(env, "aimapp", seed, steps, on_step=on_step)
+    sim.close()
     return rows
 
 

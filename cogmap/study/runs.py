@@ -100,17 +100,22 @@ def make_policy(method: str, sim, step: float, seed: int, config: dict | None = 
 
 
 def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, patience: int | None = None,
-                    config: dict | None = None, faults=(), end: dict | None = None, end_rule: str | None = None):
+                    config: dict | None = None, faults=(), end: dict | None = None, end_rule: str | None = None,
+                    on_step=None):
     """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
     ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim.
     ``end_rule`` is AIMAPP's (:class:`cogmap.explore.Done`; default ``config.AIMAPP_END_RULE``).
-    ``end``, if given, receives ``end_reason`` and (AIMAPP) ``unvisited_reachable`` (:meth:`Done.summary`)."""
+    ``end``, if given, receives ``end_reason`` and (AIMAPP) ``unvisited_reachable`` (:meth:`Done.summary`).
+    ``on_step``, if given (AIMAPP only), is called as ``on_step(sim, agent)`` after each planning call,
+    before the move: a read-only look at the run (e.g. ``bench/gain_audit.py``)."""
     from cogmap.agent.aimapp import AIMAPPAgent
     from cogmap.baselines import run_policy
     from cogmap.explore import Done, default_config, run_agent
 
     from .config import AIMAPP_END_RULE, AIMAPP_PATIENCE
 
+    if on_step is not None and not method.startswith("aimapp"):
+        raise ValueError(f"explore_episode: on_step is for AIMAPP runs, not {method!r}")
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
     for stream, start, length in faults:  # (stream, first silent step, number of silent steps)
@@ -121,7 +126,8 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
         agent = AIMAPPAgent(aimapp_config(method, env), seed=seed)
         done = Done(agent, AIMAPP_PATIENCE if patience is None else patience,  # the agent's own end
                     end_rule or AIMAPP_END_RULE)
-        ep = run_agent(sim, agent, steps, progress=False, stop=done)
+        watch = None if on_step is None else (lambda _decision: on_step(sim, agent))
+        ep = run_agent(sim, agent, steps, progress=False, on_step=watch, stop=done)
         if end is not None:
             end.update({k: v for k, v in done.summary().items() if k != "ended_by_agent"})
         return sim, ep, agent, done.finished

@@ -235,3 +235,22 @@ def test_goals_are_reached_after_a_short_exploration_of_the_mini_warehouse(seed)
     results = goal_runs({"env": "mini_warehouse", "seed": seed}, explored, params)
     assert len(results) == 2
     assert all(r["reached"] and r["steps"] <= 15 for r in results), results
+
+
+def test_explore_episode_hook_sees_every_planning_call_and_leaves_the_run_unchanged():
+    from cogmap.study.runs import explore_episode
+
+    calls = []
+    sim, plain, _, _ = explore_episode("mini_warehouse", "aimapp", 1, 30)
+    sim.close()
+    sim, watched, agent, _ = explore_episode("mini_warehouse", "aimapp", 1, 30,
+                                             on_step=lambda s, a: calls.append((s.true_pose()[:2].copy(), a)))
+    sim.close()
+    assert [r["true_x"] for r in watched.rows] == [r["true_x"] for r in plain.rows]
+    assert [r["true_y"] for r in watched.rows] == [r["true_y"] for r in plain.rows]
+    # called before each move: the pose it sees is the pose the decision's row records
+    assert len(calls) >= len(watched.rows) - 1 and all(a is agent for _, a in calls)
+    for (xy, _), row in zip(calls, watched.rows, strict=False):
+        assert np.allclose(xy, [row["true_x"], row["true_y"]])
+    with pytest.raises(ValueError, match="on_step is for AIMAPP"):
+        explore_episode("mini_warehouse", "random", 1, 5, on_step=lambda s, a: None)
