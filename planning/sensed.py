@@ -198,11 +198,32 @@ def _view_codes(grid: SensedGrid) -> np.ndarray:
     return np.pad(codes, 1, constant_values=1)
 
 
+def check_bounds(bounds, owner: str) -> tuple[float, float, float, float]:
+    """``bounds`` as a tuple ``(xmin, ymin, xmax, ymax)`` of finite floats with xmin < xmax and
+    ymin < ymax; ValueError naming ``owner`` otherwise."""
+    try:
+        b = tuple(float(v) for v in bounds)
+    except (TypeError, ValueError):
+        b = ()
+    if len(b) != 4 or not np.all(np.isfinite(b)) or b[0] >= b[2] or b[1] >= b[3]:
+        raise ValueError(f"{owner}: bounds must be (xmin, ymin, xmax, ymax) with xmin < xmax and ymin < ymax, "
+                         f"got {bounds!r}")
+    return b
+
+
+def inside_bounds(xy, bounds) -> np.ndarray:
+    """Whether each point of ``xy`` (..., 2) lies within ``bounds`` ``(xmin, ymin, xmax, ymax)``."""
+    xy = np.asarray(xy, dtype=float)
+    x0, y0, x1, y1 = bounds
+    return (xy[..., 0] >= x0) & (xy[..., 0] <= x1) & (xy[..., 1] >= y0) & (xy[..., 1] <= y1)
+
+
 def view_weights(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
-                 free_path: float = np.inf) -> tuple[np.ndarray, np.ndarray]:
+                 free_path: float = np.inf, bounds=None) -> tuple[np.ndarray, np.ndarray]:
     """The samples of the imagined views from the viewpoints ``xy`` (n, 2) and the unknown area
     (m2) each stands for (:func:`unseen_area` is their sum per viewpoint; a sample that is not
-    unknown, or not visible, weighs 0).
+    unknown, or not visible, or outside ``bounds`` ``(xmin, ymin, xmax, ymax)`` when given,
+    weighs 0).
 
     Returns
     -------
@@ -227,23 +248,28 @@ def view_weights(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip
     seen = unknown & ~blocked
     if np.isfinite(free_path):
         hidden = np.cumsum(seen, axis=2) * grid.resolution  # unknown metres up to each sample
-        return points, seen * np.exp(-hidden / free_path) * w[None, None, :]
-    return points, seen * w[None, None, :]
+        weight = seen * np.exp(-hidden / free_path) * w[None, None, :]
+    else:
+        weight = seen * w[None, None, :]
+    if bounds is not None:  # a known outline: nothing to see beyond it
+        weight = weight * inside_bounds(points, bounds)
+    return points, weight
 
 
 def unseen_area(grid: SensedGrid, xy, radius: float = 6.0, rays: int = 48, skip: float = 0.3,
-                free_path: float = np.inf) -> np.ndarray:
+                free_path: float = np.inf, bounds=None) -> np.ndarray:
     """Per viewpoint of ``xy`` (n, 2): the unknown area (m2) a scan of range ``radius`` from it
     would sweep, with occupied cells (grown by one cell, :func:`opaque`) opaque; cells outside the
     grid are unknown. Unknown cells are transparent by default; with a finite ``free_path`` (m)
     each is occupied with a small independent chance, so a sample behind ``u`` metres of unknown
     cells (itself included) counts ``exp(-u / free_path)``, the chance that nothing unknown hides
     it. Samples within ``skip`` of the viewpoint (the robot's own footprint) neither count nor
-    block. Where that area lies: :func:`view_weights`."""
+    block. With ``bounds`` ``(xmin, ymin, xmax, ymax)`` (the space's outline, when known) samples
+    beyond it do not count. Where that area lies: :func:`view_weights`."""
     xy = np.atleast_2d(np.asarray(xy, dtype=float))
     if xy.shape[0] == 0:
         return np.zeros(0)
-    return view_weights(grid, xy, radius, rays, skip, free_path)[1].sum(axis=(1, 2))
+    return view_weights(grid, xy, radius, rays, skip, free_path, bounds)[1].sum(axis=(1, 2))
 
 
 def view_area(radius: float = 6.0, rays: int = 48, resolution: float = 0.2, skip: float = 0.3,

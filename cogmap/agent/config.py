@@ -6,6 +6,7 @@ import warnings
 from dataclasses import asdict, dataclass, field, fields
 
 from cogmap.inference.learning import LearningRates
+from cogmap.planning.sensed import check_bounds
 
 
 @dataclass(frozen=True)
@@ -162,6 +163,10 @@ class AgentConfig:
         Metres: an imagined view counts an unknown cell behind ``u`` metres of unknown cells with
         weight ``exp(-u / view_free_path)`` (unknown cells independently occupied; inf:
         transparent).
+    view_bounds : tuple of float or None
+        ``(xmin, ymin, xmax, ymax)`` of the space in the belief frame, when its outline is known
+        (e.g. from a floor plan): imagined views count nothing beyond it. None (the paper's
+        agent, the default): the outline is learnt from the LiDAR like everything else.
     view_doubt_range : float
         Metres: believed transitions with both ends this close to the robot are checked against
         the latest scan.
@@ -231,11 +236,16 @@ class AgentConfig:
     view_keep_radius: float = 0.5  # m: a viewpoint this close to the pursued one is taken for it
     view_path_weight: float = 0.1  # m of the way left per m of believed path to the state preferred for a view
     view_tries: int = 8  # best viewpoints considered; none brought nearer: the paper's terms alone
+    view_bounds: tuple[float, float, float, float] | None = None  # a known outline of the space (belief frame)
     view_doubt_range: float = 4.0  # m: believed transitions this close are checked against the latest scan
     view_floor: float = 0.05  # smallest weight of a state's information gain
     explore_inductive_weight: float = 1.0  # inductive term toward states that still promise information
     learning: LearningRates = field(default_factory=LearningRates)
     initial_capacity: int = 64
+
+    def __post_init__(self):
+        if self.view_bounds is not None:
+            object.__setattr__(self, "view_bounds", check_bounds(self.view_bounds, "AgentConfig.view_bounds"))
 
     @property
     def num_actions(self) -> int:
@@ -258,11 +268,13 @@ class AgentConfig:
         Returns
         -------
         dict
-            Field name -> value; ``encoder`` is left out when it is the default ``"ssim"`` (so
-            manifests and study run keys made before encoders were chosen by name stay the same;
-            :meth:`from_dict` restores it).
+            Field name -> value; ``encoder`` is left out when it is the default ``"ssim"`` and
+            ``view_bounds`` when None (so manifests and study run keys made before these fields
+            existed stay the same; :meth:`from_dict` restores them).
         """
         d = asdict(self)
+        if d["view_bounds"] is None:  # likewise: runs that know no outline keep their keys
+            del d["view_bounds"]
         if d["encoder"] == "ssim":
             # the paper's encoder is left implicit (from_dict restores it), so the manifests and
             # study run keys of runs made before encoders were chosen by name stay the same

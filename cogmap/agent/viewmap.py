@@ -130,7 +130,8 @@ class ViewMap:
 
     def _unseen(self, xy: np.ndarray) -> np.ndarray:
         cfg = self.cfg
-        return sg.unseen_area(self.grid, xy, cfg.view_radius, cfg.view_rays, free_path=cfg.view_free_path)
+        return sg.unseen_area(self.grid, xy, cfg.view_radius, cfg.view_rays, free_path=cfg.view_free_path,
+                              bounds=cfg.view_bounds)
 
     def _frontier_areas(self, pts: np.ndarray) -> np.ndarray:
         """Unseen areas of frontier points, reusing those whose view no changed cell reaches."""

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cogmap.planning.sensed import ray_offsets
+from cogmap.planning.sensed import check_bounds, inside_bounds, ray_offsets
 
 from .frontier import FrontierConfig, FrontierExplorer
 from .gridnav import coarsen
@@ -50,12 +50,21 @@ class NBVConfig(FrontierConfig):
         Metres added to the path length in the score ``gain / (path + offset)``.
     free_path : float
         Mean free path (metres) of a ray through unseen space in the gain (:func:`unseen_gains`).
+    bounds : tuple of float or None
+        ``(xmin, ymin, xmax, ymax)`` of the space in the odometry frame, when its outline is known:
+        the map counts every cell beyond it occupied, so no ray sees past it. None (default): the
+        outline is learnt from the LiDAR.
     """
     viewpoint_spacing: float = 0.5
     rays: int = 72
     min_gain: float = 0.25
     detour_offset: float = 1.0
     free_path: float = 4.0
+    bounds: tuple[float, float, float, float] | None = None
+
+    def __post_init__(self):
+        if self.bounds is not None:
+            object.__setattr__(self, "bounds", check_bounds(self.bounds, "NBVConfig.bounds"))
 
 
 def unseen_gains(seen: np.ndarray, occ: np.ndarray, resolution: float, cells: np.ndarray, rays: int,
@@ -153,6 +162,9 @@ class NextBestView(FrontierExplorer):
         window = (slice(r0, r0 + shape[0] * f), slice(c0, c0 + shape[1] * f))
         unseen = coarsen(~m.seen[window], f)  # a planning cell is unseen while any of its cells is
         occ = coarsen(m.occ[window], f)  # and occupied when any is (walls stay closed)
+        if cfg.bounds is not None:  # a known outline: beyond it is wall
+            rc = np.stack(np.mgrid[0:shape[0], 0:shape[1]], -1) * f + (f - 1) / 2 + np.array([r0, c0])
+            occ |= ~inside_bounds(m.to_xy(rc), cfg.bounds)
         k = max(1, int(round(cfg.viewpoint_spacing / (res * f))))
         rr, cc = np.nonzero(np.isfinite(dist) & ~unseen & ~occ)
         on = ((rr + r0 // f) % k == 0) & ((cc + c0 // f) % k == 0)  # a lattice fixed in the map

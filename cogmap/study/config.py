@@ -63,7 +63,9 @@ def method_options(method: str, env: str) -> dict:
     config = {"aimapp": lambda: default_config(env).to_dict(),
               "aimapp_revisits": lambda: aimapp_config("aimapp_revisits", env).to_dict(),
               "frontier": lambda: asdict(FrontierConfig()),
-              "frontier_paper": lambda: asdict(FrontierPaperConfig()), "nbv": lambda: asdict(NBVConfig()),
+              "frontier_paper": lambda: asdict(FrontierPaperConfig()),
+              # no outline known (bounds None): left out, so the run keys stay those of earlier runs
+              "nbv": lambda: {k: v for k, v in asdict(NBVConfig()).items() if k != "bounds"},
               "oracle": lambda: asdict(OracleConfig()),
               "random": dict}[method]()
     return json.loads(json.dumps({**METHOD_OPTIONS[method], "config": config}))

@@ -8,6 +8,7 @@ import copy
 import math
 import tempfile
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -104,6 +105,8 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
                     on_step=None):
     """Run one method in a fresh simulator until its own end or the budget (the study's stop rule,
     ``config.STOP_RULE``); returns (sim, episode, agent-or-policy, ended_by_itself). Caller closes sim.
+    ``config`` overrides fields of the method's config: the baseline's dataclass, or AIMAPP's
+    ``aimapp_config(method, env)`` (e.g. ``{"view_bounds": ...}``; the studies pass none for AIMAPP).
     ``end_rule`` is AIMAPP's (:class:`cogmap.explore.Done`; default ``config.AIMAPP_END_RULE``).
     ``end``, if given, receives ``end_reason`` and (AIMAPP) ``unvisited_reachable`` (:meth:`Done.summary`).
     ``on_step``, if given (AIMAPP only), is called as ``on_step(sim, agent)`` after each planning call,
@@ -112,18 +115,18 @@ def explore_episode(env: str, method: str, seed: int, steps: int, noise=None, pa
     from cogmap.baselines import run_policy
     from cogmap.explore import Done, default_config, run_agent
 
-    from .config import AIMAPP_END_RULE, AIMAPP_PATIENCE
+    from .config import AIMAPP_END_RULE, AIMAPP_PATIENCE, aimapp_config
 
     if on_step is not None and not method.startswith("aimapp"):
         raise ValueError(f"explore_episode: on_step is for AIMAPP runs, not {method!r}")
+    if method.startswith("aimapp"):  # before the simulator opens: a bad override leaves nothing open
+        agent_cfg = replace(aimapp_config(method, env), **(config or {}))
     cfg = default_config(env)
     sim = study_sim(env, cfg, seed, noise)
     for stream, start, length in faults:  # (stream, first silent step, number of silent steps)
         sim.inject_fault(stream, start, length)
     if method.startswith("aimapp"):
-        from .config import aimapp_config
-
-        agent = AIMAPPAgent(aimapp_config(method, env), seed=seed)
+        agent = AIMAPPAgent(agent_cfg, seed=seed)
         done = Done(agent, AIMAPP_PATIENCE if patience is None else patience,  # the agent's own end
                     end_rule or AIMAPP_END_RULE)
         watch = None if on_step is None else (lambda _decision: on_step(sim, agent))

@@ -33,6 +33,7 @@ def _other(value):
 def test_round_trip_keeps_every_field_through_json():
     base = AgentConfig()
     changed = {f.name: _other(getattr(base, f.name)) for f in fields(AgentConfig) if f.name != "learning"}
+    changed["view_bounds"] = (-1.0, -2.0, 3.0, 4.0)  # an outline, not any value
     lr = LearningRates(**{f.name: _other(getattr(base.learning, f.name)) for f in fields(LearningRates)})
     cfg = AgentConfig(**changed, learning=lr)
     for f in fields(AgentConfig):  # every field really differs from its default
@@ -98,6 +99,14 @@ def test_the_default_encoder_is_implicit_in_saved_configs():
     assert "encoder" not in AgentConfig().to_dict()
     assert AgentConfig.from_dict(AgentConfig().to_dict()).encoder == "ssim"
     assert AgentConfig(encoder="mine").to_dict()["encoder"] == "mine"
+
+
+def test_no_known_outline_is_implicit_in_saved_configs_and_a_bad_one_is_refused():
+    assert "view_bounds" not in AgentConfig().to_dict()
+    assert AgentConfig.from_dict(AgentConfig().to_dict()).view_bounds is None
+    assert AgentConfig(view_bounds=[0, 0, 5, 4]).view_bounds == (0.0, 0.0, 5.0, 4.0)
+    with pytest.raises(ValueError, match="view_bounds"):
+        AgentConfig(view_bounds=(0, 0, -1, 4))
 
 
 def test_retired_fields_of_saved_configs_are_dropped_with_a_warning():

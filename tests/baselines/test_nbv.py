@@ -40,6 +40,27 @@ def test_a_wall_cuts_the_disc_and_seen_cells_do_not_count():
     assert half == pytest.approx(_strip(R, 0.05, 2.95), rel=0.02)
 
 
+def _target_after_an_open_scan(bounds):
+    """The viewpoint chosen after one scan of an open plane from the origin (every beam at range)."""
+    pol = NextBestView(NBVConfig(bounds=bounds))
+    angles = np.linspace(-np.pi, np.pi, 360, endpoint=False)
+    pose = np.zeros(3)
+    pol.observe(pose, np.full(angles.size, 12.0), angles, None)
+    pol.decide(pose)
+    return pol.target
+
+
+def test_a_known_outline_is_wall_to_its_rays():
+    free = _target_after_an_open_scan(None)
+    assert np.array_equal(_target_after_an_open_scan((-40, -40, 40, 40)), free)  # beyond every ray: no change
+    assert free[0] > 2.0  # the open plane: east, by the lattice's tie-break
+    # nothing lies east of x = 1 (or north of y = 1): the view worth the detour lies the other way
+    assert _target_after_an_open_scan((-40, -40, 1, 40))[0] < -2.0
+    assert _target_after_an_open_scan((-40, -40, 40, 1))[1] < -2.0
+    with pytest.raises(ValueError, match="NBVConfig.bounds"):
+        NBVConfig(bounds=(1, 0, 0, 1))
+
+
 def test_it_explores_the_mini_warehouse_by_itself():
     pytest.importorskip("pybullet", reason="needs the sim extra")
     from cogmap.baselines import coverage_tracker, run_policy

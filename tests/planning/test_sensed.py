@@ -107,6 +107,25 @@ def test_view_weights_lie_beyond_the_doorway_and_add_up_to_the_unseen_area():
     assert ((ratio > 0) & (ratio < 1)).all()
 
 
+def test_a_known_outline_cuts_the_imagined_view_as_the_closed_form():
+    radius, rays, res = 3.0, 180, 0.1
+    g = sg.empty((0.0, 0.0), res, 10.0)
+    xy = [[0.0, 0.0]]
+    full = sg.unseen_area(g, xy, radius, rays, skip=0.0)[0]
+    # an outline far from the view changes nothing; one 1 m east of the viewpoint keeps the part
+    # of the disc west of x = 1: pi r^2 / 2 + the strip 0 <= x <= 1 (closed form)
+    assert sg.unseen_area(g, xy, radius, rays, skip=0.0, bounds=(-5, -5, 5, 5))[0] == full
+    cut = sg.unseen_area(g, xy, radius, rays, skip=0.0, bounds=(-5.0, -5.0, 1.0, 5.0))[0]
+    strip = np.sqrt(radius**2 - 1.0) + radius**2 * np.arcsin(1.0 / radius)  # int_0^1 2 sqrt(r^2 - x^2) dx
+    assert cut == pytest.approx(np.pi * radius**2 / 2 + strip, rel=0.03)
+    points, weights = sg.view_weights(g, xy, radius, rays, skip=0.0, bounds=(-5.0, -5.0, 1.0, 5.0))
+    assert (points[..., 0][weights > 0] <= 1.0).all() and weights.sum() == pytest.approx(cut)
+    for bad in [(0, 0, 0, 1), (0, 0, 1), (0, 0, 1, np.nan), "box", None]:
+        with pytest.raises(ValueError, match="xmin < xmax"):
+            sg.check_bounds(bad, "test")
+    assert sg.check_bounds([0, 1, 2, 3], "test") == (0.0, 1.0, 2.0, 3.0)
+
+
 def test_frontier_points_lie_on_the_edge_of_the_known():
     g = sg.empty((0.0, 0.0), 0.1, 3.0)
     g = sg.mark_scan(g, (0.0, 0.0), np.array([[2.0, 0.0]]))
