@@ -8,198 +8,209 @@ A checkpoint is a directory holding
 - ``state.json``: everything else the run needs (the agent's beliefs, pose frame, counters and RNG
   state, its view map and encoder, the end-of-exploration rule, the simulator's pose, odometry and
   RNG, the episode so far and the coverage record) as a tree of plain JSON values;
-- ``arrays.npz``: the arrays that tree refers to (loaded with ``allow_pickle=False``).
+- ``arrays.npz``: the arrays that tree refers to (read by :func:`cogmap.genmodel.npzfile.read_npz`,
+  which bounds every array by the bytes the file holds before allocating it).
 
-The tree is written by a small codec: numbers, strings, lists, tuples, dicts (any hashable keys),
-sets, numpy scalars and arrays, numpy generators (their bit-generator state) and instances of
-cogmap's own classes (dataclasses, named tuples and plain objects: their fields). Shared references
-stay shared (an object met twice is written once and referred to), so, e.g., the odometry and the
-simulator keep one generator. On reading, only classes defined in ``cogmap`` are rebuilt (their
-``__init__`` is not called) and nothing is executed; anything else (a function, a foreign object)
-is refused when the checkpoint is written, naming where it sits.
+Both are written and read with one explicit schema, :func:`exploration_schema` (:mod:`cogmap.schema`):
+each field of each part has a declared type and range, and the file never names a class or a
+function; what is built on reading is fixed by the schema. A state the schema does not describe
+(an encoder registered by a user, a new attribute) is refused when the checkpoint is written,
+naming where it sits, and the run goes on without checkpoints. The planner's per-decision summary
+(``Decision.efe``, diagnostics only) is not kept: a resumed agent's last decision has an empty one.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import functools
-import importlib
 import json
+import re
 import shutil
-import types
 from pathlib import Path
 
-import numpy as np
+from cogmap.genmodel.npzfile import NpzError, read_npz
+
+from . import schema as s
 
 STATE, ARRAYS, MODEL = "state.json", "arrays.npz", "model"
-ALLOWED_MODULES = ("cogmap.",)
+#: largest ``state.json`` read, bytes (a checkpoint of a 10,000-state map is a few MB)
+MAX_STATE_BYTES = 256 << 20
+#: largest total size of the arrays of ``arrays.npz``, bytes
+MAX_ARRAY_BYTES = 8 << 30
 
 
 class CheckpointError(ValueError):
     """A state that cannot be written, or a checkpoint that cannot be read."""
 
 
-def _class_path(cls) -> str:
-    return f"{cls.__module__}:{cls.__qualname__}"
+class ModelFile(s.Field):
+    """A :class:`~cogmap.genmodel.Model`, saved beside ``state.json`` in its own format."""
 
+    shared = True
+    NAME = re.compile(r"model[0-9]{0,3}")
 
-def _lookup(path: str):
-    module, _, qual = path.partition(":")
-    if not module.startswith(ALLOWED_MODULES):
-        raise CheckpointError(f"checkpoint refers to {path}, outside cogmap (refused)")
-    obj = importlib.import_module(module)
-    try:
-        for part in qual.split("."):
-            obj = getattr(obj, part)
-    except AttributeError:
-        return None
-    return obj
-
-
-def _resolve(path: str, kind=type):
-    obj = _lookup(path)
-    if not isinstance(obj, kind):
-        raise CheckpointError(f"checkpoint refers to {path}, which is not a {kind.__name__}")
-    return obj
-
-
-class _Writer:
-    def __init__(self, directory: Path):
-        self.dir = directory
-        self.arrays: dict[str, np.ndarray] = {}
-        self.memo: dict[int, int] = {}
-        self.keep: list = []  # keeps encoded objects alive so their ids stay unique
-        self.models = 0
-
-    def _ref(self, obj):
-        key = id(obj)
-        if key in self.memo:
-            return {"$ref": self.memo[key]}, None
-        n = len(self.memo)
-        self.memo[key] = n
-        self.keep.append(obj)
-        return None, n
-
-    def encode(self, obj, where: str):
-        from cogmap.genmodel.io import save
+    @property
+    def pytype(self):
+        """:class:`~cogmap.genmodel.Model` (imported on first use)."""
         from cogmap.genmodel.model import Model
 
-        if obj is None or isinstance(obj, bool | int | float | str):
-            return obj
-        if isinstance(obj, np.generic):
-            if obj.dtype.kind not in "biuf":
-                raise CheckpointError(f"{where}: numpy scalar of dtype {obj.dtype} cannot be checkpointed")
-            return {"$np": obj.dtype.str, "v": obj.item()}
-        ref, n = self._ref(obj)
-        if ref is not None:
-            return ref
-        if isinstance(obj, np.ndarray):
-            if obj.dtype.kind not in "biufU":
-                raise CheckpointError(f"{where}: array of dtype {obj.dtype} cannot be checkpointed")
-            key = f"a{len(self.arrays)}"
-            self.arrays[key] = obj
-            return {"$id": n, "$array": key}
-        if isinstance(obj, Model):
-            name = MODEL if self.models == 0 else f"{MODEL}{self.models}"
-            self.models += 1
-            save(obj, self.dir / name)
-            return {"$id": n, "$model": name}
-        if isinstance(obj, np.random.Generator):
-            return {"$id": n, "$rng": self.encode(obj.bit_generator.state, where)}
-        if isinstance(obj, list):
-            return {"$id": n, "$list": [self.encode(v, f"{where}[{i}]") for i, v in enumerate(obj)]}
-        if isinstance(obj, tuple) and not hasattr(obj, "_fields"):
-            return {"$id": n, "$tuple": [self.encode(v, f"{where}[{i}]") for i, v in enumerate(obj)]}
-        if isinstance(obj, set | frozenset):
-            tag = "$set" if isinstance(obj, set) else "$frozenset"
-            return {"$id": n, tag: [self.encode(v, f"{where}{{}}") for v in obj]}
-        if isinstance(obj, dict):
-            return {"$id": n, "$dict": [[self.encode(k, f"{where} key"), self.encode(v, f"{where}[{k!r}]")]
-                                        for k, v in obj.items()]}
-        if isinstance(obj, functools.partial):
-            return {"$id": n, "$partial": [self.encode(obj.func, f"{where}.func"), self.encode(obj.args, f"{where}"),
-                                           self.encode(obj.keywords, f"{where}")]}
-        if isinstance(obj, types.FunctionType | types.BuiltinFunctionType):
-            path = f"{obj.__module__}:{obj.__qualname__}"
-            if not (obj.__module__ or "").startswith(ALLOWED_MODULES) or _lookup(path) is not obj:
-                raise CheckpointError(f"{where}: function {path} cannot be checkpointed (not a module-level "
-                                      f"cogmap function)")
-            return {"$id": n, "$function": path}
-        cls = type(obj)
-        if not cls.__module__.startswith(ALLOWED_MODULES):
-            raise CheckpointError(f"{where}: {_class_path(cls)} cannot be checkpointed (not a cogmap class)")
-        if hasattr(obj, "_fields"):  # a named tuple
-            return {"$id": n, "$tuple": [self.encode(v, f"{where}.{f}") for f, v in zip(obj._fields, obj, strict=True)],
-                    "$class": _class_path(cls)}
-        if dataclasses.is_dataclass(obj):
-            fields = {f.name: getattr(obj, f.name) for f in dataclasses.fields(obj)}
-            fields.update(getattr(obj, "__dict__", {}))
-        elif hasattr(obj, "__dict__"):
-            fields = dict(vars(obj))
-        else:
-            raise CheckpointError(f"{where}: {_class_path(cls)} has no fields to checkpoint")
-        return {"$id": n, "$class": _class_path(cls),
-                "$fields": {k: self.encode(v, f"{where}.{k}") for k, v in fields.items()}}
+        return Model
+
+    def write(self, value, w, where):
+        from cogmap.genmodel.io import save
+
+        if not isinstance(value, self.pytype):
+            raise s.SchemaError(f"{where}: expected a Model, got {type(value).__name__}")
+        n = w.extra.setdefault("models", 0)
+        w.extra["models"] = n + 1
+        name = MODEL if n == 0 else f"{MODEL}{n}"
+        save(value, w.extra["dir"] / name)
+        return name
+
+    def read(self, node, r, where):
+        from cogmap.genmodel.io import load
+
+        if not (isinstance(node, str) and self.NAME.fullmatch(node)):
+            raise s.SchemaError(f"{where}: expected a model file name (model, model1, ...), got "
+                                f"{str(node)[:40]!r}")
+        return load(r.extra["dir"] / node)
 
 
-class _Reader:
-    def __init__(self, directory: Path, arrays):
-        self.dir, self.arrays, self.memo = directory, arrays, {}
+class Struct(s.Field):
+    """A dict with exactly the string keys of ``fields``, each of its own field type.
 
-    def decode(self, node):
-        if not isinstance(node, dict):
-            if isinstance(node, list):
-                raise CheckpointError("malformed checkpoint: bare list")
+    Parameters
+    ----------
+    fields
+        Each key and the field type of its value.
+    """
+
+    pytype = dict
+
+    def __init__(self, fields: dict[str, s.Field]):
+        self.fields = fields
+
+    def write(self, value, w, where):
+        if not isinstance(value, dict) or value.keys() != self.fields.keys():
+            raise s.SchemaError(f"{where}: expected the keys {sorted(self.fields)}, got "
+                                f"{sorted(value) if isinstance(value, dict) else type(value).__name__}")
+        return {k: s.encode(f, value[k], w, f"{where}[{k!r}]") for k, f in self.fields.items()}
+
+    def read(self, node, r, where):
+        if not isinstance(node, dict) or node.keys() != self.fields.keys():
+            raise s.SchemaError(f"{where}: expected the keys {sorted(self.fields)}")
+        return {k: s.decode(f, node[k], r, f"{where}[{k!r}]") for k, f in self.fields.items()}
+
+
+class Scalar(s.Field):
+    """One cell of a trajectory row: null, a boolean, an integer, a float (NaN allowed) or a string."""
+
+    pytype = (type(None), bool, int, float, str)
+
+    def write(self, value, w, where):
+        import numpy as np
+
+        if value is None or isinstance(value, bool | int | float | str):
+            return value
+        if isinstance(value, np.bool_ | np.integer | np.floating):
+            return value.item()
+        raise s.SchemaError(f"{where}: {type(value).__name__} is not a plain value")
+
+    def read(self, node, r, where):
+        if node is None or isinstance(node, bool | int | float):
             return node
-        if "$ref" in node:
-            return self.memo[node["$ref"]]
-        if "$np" in node:
-            return np.dtype(node["$np"]).type(node["v"])
-        n = node.get("$id")
-        if "$array" in node:
-            out = np.array(self.arrays[node["$array"]])
-        elif "$model" in node:
-            from cogmap.genmodel.io import load
-
-            out = load(self.dir / node["$model"])
-        elif "$rng" in node:
-            state = self.decode(node["$rng"])
-            bit = getattr(np.random, state["bit_generator"])()
-            bit.state = state
-            out = np.random.Generator(bit)
-        elif "$list" in node:
-            out = []
-            self.memo[n] = out
-            out.extend(self.decode(v) for v in node["$list"])
-        elif "$set" in node or "$frozenset" in node:
-            items = [self.decode(v) for v in node.get("$set", node.get("$frozenset"))]
-            out = set(items) if "$set" in node else frozenset(items)
-        elif "$dict" in node:
-            out = {}
-            self.memo[n] = out
-            for k, v in node["$dict"]:
-                out[self.decode(k)] = self.decode(v)
-        elif "$tuple" in node:
-            items = [self.decode(v) for v in node["$tuple"]]
-            out = _resolve(node["$class"])(*items) if "$class" in node else tuple(items)
-        elif "$function" in node:
-            out = _resolve(node["$function"], types.FunctionType)
-        elif "$partial" in node:
-            fn, args, kw = (self.decode(v) for v in node["$partial"])
-            out = functools.partial(fn, *args, **kw)
-        elif "$fields" in node:
-            cls = _resolve(node["$class"])
-            out = cls.__new__(cls)
-            self.memo[n] = out
-            for k, v in node["$fields"].items():
-                object.__setattr__(out, k, self.decode(v))
-        else:
-            raise CheckpointError(f"malformed checkpoint node with keys {sorted(node)}")
-        self.memo[n] = out
-        return out
+        if isinstance(node, str) and len(node) <= s.MAX_STR:
+            return node
+        raise s.SchemaError(f"{where}: expected a plain value, got {type(node).__name__}")
 
 
-def save_checkpoint(directory: Path, state: dict) -> Path:
+def _exploration_schema() -> Struct:
+    """The schema of an exploration checkpoint (built once, on first use)."""
+    from cogmap.agent.aimapp import AIMAPPAgent, Decision
+    from cogmap.agent.confidence import Confidence
+    from cogmap.agent.config import AgentConfig
+    from cogmap.agent.correction import Anchor
+    from cogmap.agent.encoder import SSIMEncoder
+    from cogmap.agent.viewmap import ViewMap
+    from cogmap.envs.robot import Odometry, OdometryNoise
+    from cogmap.envs.sensors import STREAMS, FaultSchedule
+    from cogmap.inference.se2 import SE2
+    from cogmap.planning.sensed import SensedGrid
+
+    from .explore import Done
+    from .harness import Episode
+
+    count, index, state = s.Int(0), s.Int(-1), s.Int(0)
+    fin = s.Float()
+    xy = s.Array("f", 1, (2,))
+    pose3 = s.Array("f", 1, (3,))
+    rng = s.Generator()
+    config = s.Via(AgentConfig, s.Json(), AgentConfig.to_dict, AgentConfig.from_dict)
+    box = s.Optional(s.TupleOf(s.Int(), s.Int(), s.Int(), s.Int()))
+    encoder = s.Record(SSIMEncoder, {
+        "threshold": s.Float(-1.0, 1.0), "shortlist": s.Optional(s.Int(1)),
+        "images": s.ListOf(s.Array("uif")),
+        "_x": s.Optional(s.Array("f", 3)), "_mu": s.Optional(s.Array("f", 3)),
+        "_mu2c1": s.Optional(s.Array("f", 3)), "_varc2": s.Optional(s.Array("f", 3)),
+        "_thumbs": s.Array("f", 2), "last_scores": s.Array("f", 1)})
+    confidence = s.Record(Confidence, {"dominance": s.Float(finite=False), "conflict": s.Float(finite=False),
+                                       "lost_evidence": s.Float(finite=False), "confident": s.Bool()}, make="call")
+    decision = s.Record(Decision, {
+        "action": count, "waypoint": xy, "state": index, "target": index,
+        "mode": s.Str(("explore", "goal", "relocalise", "paused")), "confidence": s.Optional(confidence),
+        "expanded": count, "missing": s.VarTuple(s.Str(tuple(STREAMS)))}, drop={"efe": dict})
+    grid = s.Record(SensedGrid, {"cells": s.Array("i", 2), "origin": xy, "resolution": s.Float(1e-6)}, make="call")
+    views = s.Record(ViewMap, {
+        "cfg": config, "grid": s.Optional(grid), "area": s.Array("f", 1), "robot": s.Optional(xy),
+        "returns": s.Array("f", 2), "frontier_cache": s.DictOf(s.TupleOf(fin, fin), s.Float(finite=False)),
+        "_dirty_states": box, "_dirty_frontier": box, "doubt": s.SetOf(state), "target": index,
+        "unreached": count, "full": fin, "viewpoint": s.Optional(xy),
+        "spent": s.ListOf(s.TupleOf(xy, fin)), "spent_at": count, "blind": s.Bool()})
+    anchor = s.Record(Anchor, {"pose": xy, "panorama": s.Array("uif"), "scan": s.Array("f", 2), "step": count})
+    agent = s.Record(AIMAPPAgent, {
+        "cfg": config, "encoder": encoder, "rng": rng, "model": ModelFile(), "q": s.Array("f", 1),
+        "frame": s.Record(SE2, {"yaw": fin, "x": fin, "y": fin}, make="call"),
+        "anchors": s.DictOf(state, anchor), "corrections": count, "frame_moves": s.ListOf(Struct({
+            "step": count, "kind": s.Str(("correction", "relocalisation")), "moved_m": s.Float(0.0)})),
+        "last": s.Optional(decision), "goal_obs": s.Optional(state), "step_count": count,
+        "_outcome": s.Optional(s.Bool()), "lost": s.Bool(), "lost_evidence": s.Float(finite=False),
+        "lost_events": count, "last_obs": s.Optional(state), "relocalisations": count, "views": views,
+        "scanned": s.SetOf(state), "traversed": s.SetOf(s.TupleOf(state, state, state))})
+    done = s.Record(Done, {"agent": agent, "patience": count, "quiet": count, "seen": s.TupleOf(count, count),
+                           "seen_all": count, "rule": s.Str(tuple(Done.RULES)), "loop_factor": count,
+                           "pursuing": s.Bool()})
+    episode = s.Record(Episode, {"rows": s.ListOf(s.DictOf(s.Str(max_len=100), Scalar())),
+                                 "coverage": s.ListOf(s.Float(0.0, 1.0)), "distance": s.ListOf(s.Float(0.0)),
+                                 "decision_ms": s.ListOf(s.Float(0.0)), "num_states": s.ListOf(count)})
+    noise = s.Record(OdometryNoise, {k: s.Float(0.0) if k != "heading_bias" else fin
+                                     for k in ("slip", "heading_bias", "trans_std", "rot_std")}, make="call")
+    sim = Struct({
+        "pose": pose3, "odom": s.Record(Odometry, {"noise": noise, "pose": pose3, "rng": rng,
+                                                   "travelled": s.Float(0.0)}),
+        "rng": rng, "step_count": count, "path": s.ListOf(pose3), "odom_path": s.ListOf(pose3),
+        "scheduled": s.ListOf(s.TupleOf(count, s.Str(max_len=200), s.VarTuple(fin), s.Optional(fin))),
+        "faults": s.Record(FaultSchedule, {"windows": s.DictOf(s.Str(tuple(STREAMS)),
+                                                               s.ListOf(s.TupleOf(count, count)))})})
+    return Struct({"agent": agent, "done": done, "episode": episode, "moved": s.Optional(s.Bool()),
+                   "distance": s.Optional(s.Float(0.0)), "coverage_seen": s.Array("b", 2), "sim": sim})
+
+
+_SCHEMA: list[Struct] = []
+
+
+def exploration_schema() -> Struct:
+    """The schema of an exploration checkpoint: its parts ``agent``, ``done``, ``episode``,
+    ``moved``, ``distance``, ``coverage_seen`` and ``sim``, and every field of each.
+
+    Returns
+    -------
+    Struct
+        The schema (built once, on first use).
+    """
+    if not _SCHEMA:
+        _SCHEMA.append(_exploration_schema())
+    return _SCHEMA[0]
+
+
+def save_checkpoint(directory: Path, state: dict, schema: s.Field | None = None) -> Path:
     """Write ``state`` as a checkpoint directory, atomically.
 
     The checkpoint is written to ``<directory>.new`` first; the previous checkpoint is moved to
@@ -211,10 +222,9 @@ def save_checkpoint(directory: Path, state: dict) -> Path:
     directory : pathlib.Path
         Checkpoint directory (created, or replaced when it exists).
     state : dict
-        Named parts (string keys) of the state; each value is written with the codec of the
-        module docstring (plain values, containers, numpy scalars and arrays of bool, integer,
-        float or string dtype, generators, models, module-level cogmap functions and instances of
-        cogmap classes).
+        The state, as ``schema`` describes it.
+    schema : cogmap.schema.Field, optional
+        Its schema, default :func:`exploration_schema`.
 
     Returns
     -------
@@ -224,16 +234,25 @@ def save_checkpoint(directory: Path, state: dict) -> Path:
     Raises
     ------
     CheckpointError
-        When a value cannot be written (a foreign object, a lambda, an unsupported dtype), naming
-        where it sits in ``state``.
+        When a value does not fit the schema (an object it does not describe, a value out of
+        range), naming where it sits in ``state``; nothing is left at ``directory`` then but the
+        previous checkpoint.
     """
     directory = Path(directory)
+    schema = schema or exploration_schema()
     tmp = directory.with_name(directory.name + ".new")
     if tmp.exists():
         shutil.rmtree(tmp)
     tmp.mkdir(parents=True)
-    w = _Writer(tmp)
-    tree = {k: w.encode(v, k) for k, v in state.items()}
+    w = s.Writer()
+    w.extra["dir"] = tmp
+    try:
+        tree = s.encode(schema, state, w, "state")
+    except s.SchemaError as err:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise CheckpointError(str(err)) from None
+    import numpy as np
+
     np.savez(tmp / ARRAYS, **w.arrays)
     (tmp / STATE).write_text(json.dumps(tree))
     old = directory.with_name(directory.name + ".old")
@@ -268,35 +287,47 @@ def find_checkpoint(directory: Path) -> Path | None:
     return None
 
 
-def load_checkpoint(directory: Path) -> dict:
-    """The state written by :func:`save_checkpoint`.
+def load_checkpoint(directory: Path, schema: s.Field | None = None) -> dict:
+    """The state written by :func:`save_checkpoint`, read with the same schema.
 
-    Only classes and functions defined in ``cogmap`` are rebuilt (instances without calling their
-    ``__init__``); shared references are shared again; nothing is unpickled.
+    Every field is checked against its declared type and range; shared references are shared
+    again; nothing is unpickled and nothing in the file chooses what is built.
 
     Parameters
     ----------
     directory : pathlib.Path
         A complete checkpoint directory (see :func:`find_checkpoint`).
+    schema : cogmap.schema.Field, optional
+        Its schema, default :func:`exploration_schema`.
 
     Returns
     -------
     dict
-        The named parts, as they were saved.
+        The state, as it was saved.
 
     Raises
     ------
     CheckpointError
-        When ``state.json`` or ``arrays.npz`` cannot be read, the tree is malformed, or it refers
-        to a class or function outside cogmap. The model's own loader
-        (:func:`cogmap.genmodel.io.load`) raises its own errors on a damaged model.
+        When ``state.json`` or ``arrays.npz`` cannot be read or exceed :data:`MAX_STATE_BYTES` /
+        :data:`MAX_ARRAY_BYTES`, or a field does not fit the schema (the message names it). The
+        model's own loader (:func:`cogmap.genmodel.io.load`) raises its own errors on a damaged
+        model.
     """
     directory = Path(directory)
+    schema = schema or exploration_schema()
     try:
+        size = (directory / STATE).stat().st_size
+        if size > MAX_STATE_BYTES:
+            raise CheckpointError(f"{directory / STATE}: {size} bytes, more than the limit of {MAX_STATE_BYTES}")
         tree = json.loads((directory / STATE).read_text())
-        with np.load(directory / ARRAYS, allow_pickle=False) as z:
-            arrays = {k: z[k] for k in z.files}
-    except (OSError, ValueError) as err:
-        raise CheckpointError(f"{directory}: unreadable checkpoint ({err})") from None
-    r = _Reader(directory, arrays)
-    return {k: r.decode(v) for k, v in tree.items()}
+        arrays = read_npz(directory / ARRAYS, kinds="biuf", max_bytes=MAX_ARRAY_BYTES)
+    except (OSError, ValueError, RecursionError) as err:
+        if isinstance(err, CheckpointError):
+            raise
+        msg = str(err) if isinstance(err, NpzError) else f"{directory}: unreadable checkpoint ({err})"
+        raise CheckpointError(msg) from None
+    r = s.Reader(arrays, dir=directory)
+    try:
+        return s.decode(schema, tree, r, "state")
+    except s.SchemaError as err:
+        raise CheckpointError(f"{directory / STATE}: {err}") from None

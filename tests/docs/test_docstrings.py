@@ -21,7 +21,7 @@ from pathlib import Path
 PACKAGES = ("cogmap.genmodel", "cogmap.inference", "cogmap.planning", "cogmap.envs",
             "cogmap.baselines", "cogmap.drone", "cogmap.study")
 MODULES = ("cogmap.loop", "cogmap.harness", "cogmap.agent.aimapp", "cogmap.agent.config", "cogmap.agent.encoder",
-           "cogmap.explore", "cogmap.goal", "cogmap.checkpoint", "cogmap.runguard",
+           "cogmap.explore", "cogmap.goal", "cogmap.checkpoint", "cogmap.schema", "cogmap.runguard",
            "cogmap.dvbf.navigate", "cogmap.dvbf.explore", "cogmap.dvbf.run", "cogmap.dvbf.slam",
            "cogmap.metrics", "cogmap.starts", "cogmap.plots", "cogmap.compare")
 # Source files being rewritten on another branch at the time of writing: their names are left out
