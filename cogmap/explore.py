@@ -48,12 +48,16 @@ def layout_name(env: str) -> str:
     Raises
     ------
     ValueError
-        For anything else (the message lists what is accepted).
+        For anything else: the id of an environment another command runs (the message names the
+        command), a file of a type that is not read (the message names the types that are), or an
+        unknown name (the message lists what is accepted).
     """
     from cogmap.envs.layout_file import is_layout_file
     from cogmap.envs.layouts import LAYOUTS
     from cogmap.envs.registry import LAYOUT_IDS
 
+    if not isinstance(env, str) or not env:
+        raise ValueError(f"env: expected a layout name, registered id, building:KIND:SEED or layout file, got {env!r}")
     if env in LAYOUT_IDS:
         return LAYOUT_IDS[env]
     if env in LAYOUTS:
@@ -63,8 +67,24 @@ def layout_name(env: str) -> str:
     if env.startswith("building:"):
         building_spec(env)  # checked here
         return env
+    if env in OTHER_COMMANDS:
+        raise ValueError(f"{env} is not a room for cogmap explore: {OTHER_COMMANDS[env]}")
+    if Path(env).suffix or Path(env).exists():
+        raise ValueError(f"{env}: not a layout file cogmap reads; --env reads a .json building or a .png plan "
+                         f"(see docs/tutorial-aimapp.md)")
     raise ValueError(f"unknown environment {env!r}; use one of {sorted(LAYOUTS)}, {sorted(LAYOUT_IDS)}, "
-                     f"building:KIND:SEED or a layout file (.json or .png)")
+                     f"building:KIND:SEED or a layout file (.json building or .png plan)")
+
+
+#: registered ids of environments that other commands run, and what to run instead
+OTHER_COMMANDS = {
+    "cogmap/DroneField-v0": "it is the drone's 3D obstacle field; fly it with 'cogmap drone fly' "
+                            "(or gymnasium.make('cogmap/DroneField-v0'))",
+    "cogmap/LidarMaze-v0": "it is the DVBF-LM LiDAR maze; run it with 'cogmap dvbf slam', 'cogmap dvbf navigate' "
+                           "or 'cogmap dvbf explore' (--maze SEED)",
+    "cogmap/GridWorld-v0": "it is the discrete grid world; use it from Python with "
+                           "gymnasium.make('cogmap/GridWorld-v0')",
+}
 
 
 def building_spec(env: str) -> tuple[str, int]:
@@ -90,13 +110,16 @@ def building_spec(env: str) -> tuple[str, int]:
     return parts[1], int(parts[2])
 
 
-def resolve_layout(env: str):
+def resolve_layout(env: str, check_space: bool = True):
     """The :class:`~cogmap.envs.layouts.Layout` that ``env`` names (see :func:`layout_name`).
 
     Parameters
     ----------
     env : str
         A layout name, registered id, ``building:KIND:SEED`` or layout file.
+    check_space : bool, optional
+        For a layout file: also run the checks that rasterise the building (free space, starts;
+        :func:`cogmap.envs.layout_file.check_layout`); False reads and bounds every entry only.
 
     Returns
     -------
@@ -107,11 +130,33 @@ def resolve_layout(env: str):
 
     name = layout_name(env)
     if is_layout_file(name):
-        return load_layout(name)
+        return load_layout(name, check_space=check_space)
     if name.startswith("building:"):
         kind, seed = building_spec(name)
         return make_layout("building", seed, kind=kind)
     return make_layout(name)
+
+
+def check_env(env: str) -> None:
+    """The quick check of ``env`` before a run starts (``cogmap explore`` runs it before the
+    supervised child): the name resolves, and a layout file is read with every entry checked and
+    bounded (:data:`~cogmap.envs.layout_file.MAX_EXTENT_M`, ...). The checks that rasterise the
+    building (free space, starts) run in the run itself, under its time limit.
+
+    Parameters
+    ----------
+    env : str
+        As for :func:`layout_name`.
+
+    Raises
+    ------
+    ValueError
+        From :func:`layout_name` or :class:`~cogmap.envs.layout_file.LayoutFileError`.
+    """
+    from cogmap.envs.layout_file import is_layout_file
+
+    if is_layout_file(layout_name(env)):
+        resolve_layout(env, check_space=False)
 
 
 def default_config(env: str) -> AgentConfig:
@@ -130,7 +175,7 @@ def default_config(env: str) -> AgentConfig:
     return AgentConfig(influence_radius=2.0 if large else 1.0)
 
 
-def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
+def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None, layout=None):
     """The room, with the start pose chosen by the seed: every seed starts somewhere else, as in
     the paper's protocol (the layout's start poses first, then poses sampled from the free
     space; :func:`cogmap.starts.seed_start`).
@@ -145,6 +190,9 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
         Start pose and noise seed.
     noise : OdometryNoise, optional
         Odometry drift; default none.
+    layout : Layout, optional
+        ``resolve_layout(env)`` when the caller has it already (a layout file is then not read and
+        validated twice).
 
     Returns
     -------
@@ -154,7 +202,7 @@ def make_sim(env: str, cfg: AgentConfig, seed: int, noise=None):
 
     from .starts import seed_start
 
-    layout = resolve_layout(env)
+    layout = layout if layout is not None else resolve_layout(env)
     sim_cfg = SimConfig(step_length=cfg.influence_radius, obstacle_margin=cfg.obstacle_margin,
                         noise=noise or OdometryNoise())
     return NavSim(layout, sim_cfg, seed=seed, start=seed_start(layout, seed, sim_cfg.robot_radius))
@@ -454,6 +502,132 @@ def restore_state(path: Path, sim) -> tuple[AIMAPPAgent, Done, Episode, bool | N
     return st["agent"], st["done"], st["episode"], st["moved"], st["distance"]
 
 
+def check_settings(where: str, **settings) -> None:
+    """Refuse an exploration setting of the wrong type or out of its range, naming it.
+
+    Parameters
+    ----------
+    where : str
+        Prefix of the message (the function, or the ``run.json`` the settings were read from).
+    **settings
+        Any of ``steps`` (1 .. :data:`~cogmap.argtypes.MAX_DECISIONS`), ``seed`` (0 ..
+        :data:`~cogmap.argtypes.MAX_SEED`), ``patience`` (0 .. ``MAX_DECISIONS``) and
+        ``checkpoint_every`` (1 .. ``MAX_DECISIONS``), integers (not bools).
+
+    Raises
+    ------
+    ValueError
+        ``"<where>: <field>: ..."`` naming the range and the value.
+    """
+    from .argtypes import MAX_DECISIONS, MAX_SEED
+
+    ranges = {"steps": (1, MAX_DECISIONS, "MAX_DECISIONS"), "seed": (0, MAX_SEED, "MAX_SEED"),
+              "patience": (0, MAX_DECISIONS, "MAX_DECISIONS"), "checkpoint_every": (1, MAX_DECISIONS, "MAX_DECISIONS")}
+    for key, value in settings.items():
+        lo, hi, name = ranges[key]
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or not lo <= value <= hi:
+            raise ValueError(f"{where}: {key}: expected an integer in {lo}..{hi} ({name}), got {_shown(value)}")
+
+
+def _shown(value) -> str:
+    """A value as the file holds it (JSON), else its repr."""
+    try:
+        return json.dumps(value)
+    except (TypeError, ValueError):
+        return repr(value)
+
+
+def resume_state(out: Path) -> str:
+    """What ``--resume`` can do with the run directory of a stopped exploration, as the end of the
+    message of ``cogmap explore`` (:func:`cogmap.runguard.resume_hint`); it checks what
+    :func:`resume_settings` needs.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The run directory.
+
+    Returns
+    -------
+    str
+        ``" (--resume continues it)"`` when ``run.json`` is there (from the last checkpoint, or
+        from the start without one), else why ``--resume`` cannot continue it and what to do.
+    """
+    if (out / "metrics.json").is_file():
+        return " (it had written its results, metrics.json: --resume has nothing to continue)"
+    if (out / "run.json").is_file():
+        return " (--resume continues it)"
+    return " (--resume cannot continue it: it stopped before writing run.json; start it again with --force)"
+
+
+def resume_settings(out: Path, checkpoint_every: int = 10) -> tuple:
+    """The settings of the exploration in ``out`` to resume, read from its ``run.json`` with every
+    field checked (type and range) before anything is built.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The run directory.
+    checkpoint_every : int, optional
+        Used when ``run.json`` has no ``checkpoint_every`` (runs written before it was recorded).
+
+    Returns
+    -------
+    tuple
+        ``(env, steps, seed, patience, checkpoint_every, config, noise)``.
+
+    Raises
+    ------
+    ValueError
+        When ``run.json`` is missing or unreadable, not an exploration's, the run has finished, or
+        a field is missing or of the wrong type or range (``"<out>/run.json: <field>: ..."``).
+    """
+    from cogmap.envs import OdometryNoise
+
+    where = f"{out}/run.json"
+    try:
+        manifest = json.loads((out / "run.json").read_text())
+    except (OSError, ValueError):
+        raise ValueError(f"{out}: no readable run.json to resume from") from None
+    if not isinstance(manifest, dict):
+        raise ValueError(f"{where}: expected a JSON object, got {type(manifest).__name__}")
+    if manifest.get("command") != "explore":
+        raise ValueError(f"{out}: not an exploration run (run.json says {manifest.get('command')!r})")
+    if (out / "metrics.json").exists():
+        raise ValueError(f"{out}: the run has finished (metrics.json); nothing to resume")
+    for key in ("env", "steps", "seed", "patience", "config", "noise"):
+        if key not in manifest:
+            raise ValueError(f"{where}: missing field {key!r}")
+    settings = {k: manifest[k] for k in ("steps", "seed", "patience")}
+    settings["checkpoint_every"] = manifest.get("checkpoint_every", checkpoint_every)
+    check_settings(where, **settings)
+    env = manifest["env"]
+    if not isinstance(env, str):
+        raise ValueError(f"{where}: env: expected a string, got {_shown(env)}")
+    try:
+        layout_name(env)
+    except ValueError as err:
+        raise ValueError(f"{where}: env: {err}") from None
+    if not isinstance(manifest["config"], dict):
+        raise ValueError(f"{where}: config: expected an object of AgentConfig fields, got {_shown(manifest['config'])}")
+    try:
+        config = AgentConfig.from_dict(manifest["config"])
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{where}: config: {err}") from None
+    noise = manifest["noise"]
+    if not isinstance(noise, dict):
+        raise ValueError(f"{where}: noise: expected an object of OdometryNoise fields, got {_shown(noise)}")
+    unknown = sorted(set(noise) - {"slip", "heading_bias", "trans_std", "rot_std"})
+    if unknown:
+        raise ValueError(f"{where}: noise: unknown field(s) {', '.join(map(repr, unknown))}")
+    try:
+        noise = OdometryNoise(**noise)
+    except ValueError as err:
+        raise ValueError(f"{where}: noise: {err}") from None
+    return (env, settings["steps"], settings["seed"], settings["patience"], settings["checkpoint_every"], config,
+            noise)
+
+
 def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: Path | str | None = None,
             config: AgentConfig | None = None, progress: bool = True, noise=None, patience: int = 20,
             checkpoint_every: int = 10, resume: bool = False) -> dict:
@@ -497,7 +671,9 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
     Raises
     ------
     ValueError
-        When ``resume`` is asked without ``out``.
+        When ``resume`` is asked without ``out``, a setting is out of its range
+        (:func:`check_settings`), or, on ``resume``, ``run.json`` is missing, not an exploration's,
+        or holds a field of the wrong type or range (the message names the field).
     """
     from cogmap.envs import OdometryNoise
 
@@ -508,20 +684,18 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
         if out is None:
             raise ValueError("resume needs the run directory (out)")
         out = Path(out)
-        try:
-            manifest = json.loads((out / "run.json").read_text())
-        except (OSError, ValueError):
-            raise ValueError(f"{out}: no readable run.json to resume from") from None
-        if manifest.get("command") != "explore":
-            raise ValueError(f"{out}: not an exploration run (run.json says {manifest.get('command')!r})")
-        if (out / "metrics.json").exists():
-            raise ValueError(f"{out}: the run has finished (metrics.json); nothing to resume")
-        env, steps, seed, patience = manifest["env"], manifest["steps"], manifest["seed"], manifest["patience"]
-        config = AgentConfig.from_dict(manifest["config"])
-        noise = OdometryNoise(**manifest["noise"])
-        checkpoint_every = manifest.get("checkpoint_every", checkpoint_every)
+        env, steps, seed, patience, checkpoint_every, config, noise = resume_settings(out, checkpoint_every)
+    else:
+        check_settings("explore", steps=steps, seed=seed, patience=patience, checkpoint_every=checkpoint_every)
     cfg = config or default_config(env)
-    sim = make_sim(env, cfg, seed, noise)
+    layout = resolve_layout(env)  # a layout file is validated here, in the run (under its time limit)
+    if out is not None and not resume:
+        # run.json before the work a time limit may cut, so that --resume can continue from here
+        out = Path(out)
+        write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed,
+                       patience=patience, checkpoint_every=checkpoint_every, config=cfg.to_dict(),
+                       noise=asdict(noise or OdometryNoise()))
+    sim = make_sim(env, cfg, seed, noise, layout=layout)
     try:
         found = find_checkpoint(out / CHECKPOINT) if resume else None
         if found is not None:
@@ -533,11 +707,6 @@ def explore(env: str = "mini_warehouse", steps: int = 150, seed: int = 0, out: P
         else:
             agent = AIMAPPAgent(cfg, seed=seed)
             done, ep, moved, distance = Done(agent, patience), Episode(), None, None
-            if out is not None and not resume:
-                out = Path(out)
-                write_manifest(out, command="explore", env=layout_name(env), steps=steps, seed=seed,
-                               patience=patience, checkpoint_every=checkpoint_every, config=cfg.to_dict(),
-                               noise=asdict(noise or OdometryNoise()))
 
         failed_checkpoint: list[str] = []
 

@@ -49,6 +49,48 @@ def astar_length(grid, start_xy, goal_xy, robot_radius: float) -> float:
     return float(length)
 
 
+def exploration_manifest(run: Path) -> dict:
+    """The ``run.json`` of an exploration run, read and checked before anything is built from it.
+
+    Its ``"command"`` field is read first, so another kind of run directory (``cogmap drone fly``,
+    ``cogmap dvbf ...``, a goal run) is named as such instead of failing on a field it lacks.
+
+    Parameters
+    ----------
+    run : pathlib.Path
+        The run directory.
+
+    Returns
+    -------
+    dict
+        The manifest.
+
+    Raises
+    ------
+    FileNotFoundError
+        When ``run/run.json`` does not exist.
+    ValueError
+        ``"DIR is a <command> run; goal needs an exploration run (cogmap explore)"``, or a
+        manifest that is not JSON, not an object, or lacks ``config``, ``env`` or ``seed``.
+    """
+    path = Path(run) / "run.json"
+    try:
+        manifest = json.loads(path.read_text())
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise ValueError(f"{path}: not valid JSON ({err})") from None
+    if not isinstance(manifest, dict):
+        raise ValueError(f"{path}: expected a JSON object, got {type(manifest).__name__}")
+    command = manifest.get("command")
+    if command != "explore":
+        what = f"a {command} run" if isinstance(command, str) and command else \
+            "not an exploration run (its run.json names no command)"
+        raise ValueError(f"{run} is {what}; goal needs an exploration run (cogmap explore)")
+    for key, kind, name in (("config", dict, "an object"), ("env", str, "a string"), ("seed", int, "an integer")):
+        if not isinstance(manifest.get(key), kind):
+            raise ValueError(f"{path}: field {key!r}: expected {name}, got {json.dumps(manifest.get(key))}")
+    return manifest
+
+
 def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
     """Rebuild an agent (model, observations, config) from a run directory.
 
@@ -73,15 +115,16 @@ def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
     Raises
     ------
     ValueError
-        When the run's encoder has no ``add(image)`` method (register custom encoders before
-        loading), or the number of observation images differs from the model's outcomes.
+        When ``run`` is not an exploration run (:func:`exploration_manifest`), the run's encoder
+        has no ``add(image)`` method (register custom encoders before loading), or the number of
+        observation images differs from the model's outcomes.
     """
     import cv2
 
     from cogmap.genmodel.io import load
 
     run = Path(run)
-    manifest = json.loads((run / "run.json").read_text())
+    manifest = exploration_manifest(run)
     cfg = AgentConfig.from_dict(manifest["config"])
     encoder = make_encoder(cfg.encoder, cfg)  # the run's encoder, by name (register yours before loading)
     if not hasattr(encoder, "add"):

@@ -27,6 +27,7 @@ import numpy as np
 from cogmap import inference
 from cogmap.genmodel import Model, SpecError
 from cogmap.inference.learning import learn_observation
+from cogmap.inference.registry import check_options
 from cogmap.planning import efe
 from cogmap.planning.decide import MODES, make_objective
 from cogmap.planning.mcts import MCTSConfig
@@ -191,13 +192,16 @@ def init(
     KeyError
         For an unknown inference scheme.
     ValueError
-        For an unknown planner or objective name, or invalid ``policy_len`` / ``gamma``.
+        For an unknown planner or objective name, or invalid ``policy_len`` / ``gamma``;
+        :class:`~cogmap.inference.InferenceError` for a scheme option the scheme does not accept
+        (:func:`cogmap.inference.registry.options`).
     SpecError
         If learning is asked for without the counts it needs.
     """
     if not isinstance(model, Model):
         raise TypeError(f"init needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")
     inference.get(scheme)  # unknown names fail here, listing the known ones
+    check_options(scheme, scheme_options)  # and options the scheme does not take, naming them
     if not isinstance(planner, str) or planner not in available_planners():
         raise ValueError(f"unknown planner {planner!r} (known: {', '.join(available_planners())})")
     if not (isinstance(policy_len, int | np.integer) and policy_len >= 1):

@@ -6,8 +6,10 @@
   a child process supervised as study runs are (:func:`cogmap.study.supervisor.run_one`); past the
   limit the child is killed (a native call that never returns cannot be interrupted from inside),
   the run directory keeps what was written, ``failed.json`` records why, and the command ends with
-  one line and a non-zero exit status. ``--debug`` runs the command in this process instead (so the
-  traceback and a debugger reach the error), without the limit.
+  one line and a non-zero exit status; for a command that can resume, the line says whether
+  ``--resume`` can continue the run in the state it was stopped in (:func:`resume_hint`).
+  ``--debug`` runs the command in this process instead (so the traceback and a debugger reach the
+  error), without the limit.
 - ``--force`` / ``--resume``: a non-empty run directory is refused unless ``--force`` (clear it
   first) or ``--resume`` (continue the run it holds; only where the command supports it).
 """
@@ -204,6 +206,8 @@ def run_command(args, command: str, out: Path | None) -> int:
     """
     from .study.supervisor import run_one
 
+    if args.resume and not args.resumable:  # before the command's own checks: the flag is the mistake
+        raise RunDirError(f"--resume is not supported by {command}; start again with --force")
     check = getattr(args, "precheck", None)
     if check is not None:  # bad input is refused here, before a child starts or a directory is touched
         check(args)
@@ -212,7 +216,7 @@ def run_command(args, command: str, out: Path | None) -> int:
     if not limit or getattr(args, "debug", False):
         return args.func(args)
     try:
-        local = ("out_dir", "precheck")  # functions of the parser, not picklable
+        local = ("out_dir", "precheck", "resume_state")  # functions of the parser, not picklable
         plain = argparse.Namespace(**{k: v for k, v in vars(args).items() if k not in local})
         ok, result = run_one(_child, {"args": plain}, limit)
     except KeyboardInterrupt:
@@ -226,7 +230,33 @@ def run_command(args, command: str, out: Path | None) -> int:
             raise RunFailed(result["error"])
         return result["code"]
     reason = result
+    again = resume_hint(args, out)
     write_failed(out, command, reason, time_limit_s=limit)
     kept = f"; what it wrote is kept in {out} ({FAILED} says why)" if out is not None else ""
-    again = " (--resume continues it)" if args.resumable and out is not None else ""
     raise RunFailed(f"run stopped: {reason}{kept}{again}")
+
+
+def resume_hint(args, out: Path | None) -> str:
+    """The end of the message of a stopped run: what ``--resume`` can do with what was kept.
+
+    A command that can resume may set the parser default ``resume_state`` to a function of the
+    run directory returning that text (what its ``--resume`` needs is then checked, e.g. explore's
+    ``run.json``); otherwise ``" (--resume continues it)"``. Empty for a command that cannot
+    resume or writes no run directory.
+
+    Parameters
+    ----------
+    args
+        The command's parsed arguments.
+    out
+        The run directory, or None.
+
+    Returns
+    -------
+    str
+        The text to append to the one-line message.
+    """
+    if not getattr(args, "resumable", False) or out is None:
+        return ""
+    state = getattr(args, "resume_state", None)
+    return state(Path(out)) if state is not None else " (--resume continues it)"

@@ -23,7 +23,9 @@ problem: missing or unknown keys, non-numeric, non-finite or non-positive sizes,
 length, gaps outside their wall, duplicate names, starts outside the bounds or where the robot does
 not fit, no free space, starts that cannot reach each other, free space open to the outside, files
 that are not regular files or are too large, images with too many pixels (checked from the PNG
-header before decoding).
+header before decoding), buildings larger than :data:`MAX_EXTENT_M` on a side or whose validation
+grid would exceed :data:`MAX_GRID_CELLS` cells (checked from the bounds, the walls' extent or the
+image size times ``metres_per_pixel``, before any grid is allocated).
 """
 
 from __future__ import annotations
@@ -51,6 +53,14 @@ DEFAULT_METRES_PER_PIXEL = 0.05
 NUM_SAMPLED_STARTS = 5
 START_CLEARANCE = ROBOT_RADIUS + 0.05  # a start needs this much room around the robot's centre
 GRID_RESOLUTION = 0.05
+#: largest side of a building, metres (its bounds, or the walls' and furniture's extent, or a plan's
+#: pixels times ``metres_per_pixel``); every built-in layout and procedural building is under 40 m
+MAX_EXTENT_M = 100.0
+#: largest validation grid (cells of :data:`GRID_RESOLUTION` over the bounds), checked before it is
+#: allocated: a 100 m square at 0.05 m, validated in about 1 s with about 0.35 GB at peak
+MAX_GRID_CELLS = 4_000_000
+#: largest |coordinate| of a wall end, a piece of furniture, a bound or a start, metres
+MAX_COORDINATE_M = 10_000.0
 
 _TOP = {"format", "name", "bounds", "walls", "furniture", "starts", "texture_seed", "image", "metres_per_pixel"}
 _WALL = {"from", "to", "thickness", "height", "color", "gaps"}
@@ -81,7 +91,8 @@ class _Reader:
             self.fail(where, f"unknown key {unknown[0]!r} (known: {', '.join(sorted(allowed))})")
         return d
 
-    def number(self, v, where: str, positive: bool = False, nonnegative: bool = False) -> float:
+    def number(self, v, where: str, positive: bool = False, nonnegative: bool = False,
+               size: bool = False, coordinate: bool = False) -> float:
         if isinstance(v, bool) or not isinstance(v, int | float):
             self.fail(where, f"expected a number, got {json.dumps(v)}")
         v = float(v)
@@ -91,6 +102,10 @@ class _Reader:
             self.fail(where, f"must be positive, got {v:g}")
         if nonnegative and v < 0:
             self.fail(where, f"must not be negative, got {v:g}")
+        if size and v > MAX_EXTENT_M:
+            self.fail(where, f"{v:g} m, above the limit of {MAX_EXTENT_M:g} m (MAX_EXTENT_M)")
+        if coordinate and abs(v) > MAX_COORDINATE_M:
+            self.fail(where, f"{v:g} m, beyond the limit of +-{MAX_COORDINATE_M:g} m (MAX_COORDINATE_M)")
         return v
 
     def vector(self, v, where: str, n: int, **kw) -> tuple[float, ...]:
@@ -128,9 +143,42 @@ def _regular_file(path: Path) -> int:
     return st.st_size
 
 
+def check_extent(bounds, source: str = "layout", where: str = "bounds") -> None:
+    """Refuse a building larger than :data:`MAX_EXTENT_M` on a side, or whose validation grid would
+    have more than :data:`MAX_GRID_CELLS` cells, before any grid is allocated.
+
+    Parameters
+    ----------
+    bounds : sequence of float
+        ``(xmin, ymin, xmax, ymax)`` in metres.
+    source : str, optional
+        The file, for the message.
+    where : str, optional
+        The entry the extent comes from (``bounds``, ``walls``, ``image``), for the message.
+
+    Raises
+    ------
+    LayoutFileError
+        Naming the entry, the size and the limit.
+    """
+    xmin, ymin, xmax, ymax = (float(v) for v in bounds)
+    w, h = xmax - xmin, ymax - ymin
+    if not (math.isfinite(w) and math.isfinite(h)) or max(w, h) > MAX_EXTENT_M:
+        raise LayoutFileError(f"{source}: {where}: the building spans {w:.6g} x {h:.6g} m, above the limit of "
+                              f"{MAX_EXTENT_M:g} m on a side (MAX_EXTENT_M)")
+    cells = math.ceil(w / GRID_RESOLUTION - 1e-9) * math.ceil(h / GRID_RESOLUTION - 1e-9)
+    if cells > MAX_GRID_CELLS:
+        raise LayoutFileError(f"{source}: {where}: {w:.6g} x {h:.6g} m needs {cells} grid cells of "
+                              f"{GRID_RESOLUTION:g} m, above the limit of {MAX_GRID_CELLS} (MAX_GRID_CELLS)")
+
+
 # -- JSON --------------------------------------------------------------------------------------------
-def layout_from_dict(d: dict, source: str = "layout", base_dir: Path | None = None) -> Layout:
-    """Build and validate a layout from its JSON description (see the module docstring)."""
+def layout_from_dict(d: dict, source: str = "layout", base_dir: Path | None = None,
+                     check_space: bool = True) -> Layout:
+    """Build and validate a layout from its JSON description (see the module docstring).
+
+    ``check_space=False`` skips the checks that rasterise the building (free space, starts; see
+    :func:`check_layout`): every entry is still read and bounded, quickly."""
     r = _Reader(source)
     r.keys(d, "", _TOP, ("name",))
     if d.get("format", FORMAT) != FORMAT:
@@ -172,27 +220,37 @@ def layout_from_dict(d: dict, source: str = "layout", base_dir: Path | None = No
     if dup:
         r.fail("furniture", f"name {dup[0]!r} used twice")
     if "bounds" in d:
-        xmin, ymin, xmax, ymax = r.vector(d["bounds"], "bounds", 4)
+        xmin, ymin, xmax, ymax = r.vector(d["bounds"], "bounds", 4, coordinate=True)
         if xmax <= xmin or ymax <= ymin:
             r.fail("bounds", f"expected [xmin, ymin, xmax, ymax] with xmin < xmax and ymin < ymax, got {d['bounds']}")
         bounds = (xmin, ymin, xmax, ymax)
+        check_extent(bounds, source, "bounds")
     elif bounds is None:
         bounds = _extent(b.shapes)
+        check_extent(bounds, source, "walls")
     starts = d.get("starts")
     if starts is not None:
         if not isinstance(starts, list) or not starts:
             r.fail("starts", "expected a non-empty list of [x, y, yaw]")
-        starts = [r.vector(s, f"starts[{i}]", 3) for i, s in enumerate(starts)]
+        starts = [r.vector(s, f"starts[{i}]", 3, coordinate=True) for i, s in enumerate(starts)]
     layout = Layout(name, tuple(float(v) for v in bounds), tuple(b.shapes), (), None, seed)
+    if not check_space:
+        return layout if starts is None else _with_starts(layout, starts)
     return check_layout(layout, starts, source)
+
+
+def _with_starts(layout: Layout, starts) -> Layout:
+    import dataclasses
+
+    return dataclasses.replace(layout, starts=tuple(tuple(float(v) for v in s) for s in starts))
 
 
 def _wall(b: _Builder, r: _Reader, w, where: str) -> None:
     r.keys(w, where, _WALL, ("from", "to"))
-    x0, y0 = r.vector(w["from"], f"{where}.from", 2)
-    x1, y1 = r.vector(w["to"], f"{where}.to", 2)
-    t = r.number(w.get("thickness", WALL), f"{where}.thickness", positive=True)
-    h = r.number(w.get("height", WALL_H), f"{where}.height", positive=True)
+    x0, y0 = r.vector(w["from"], f"{where}.from", 2, coordinate=True)
+    x1, y1 = r.vector(w["to"], f"{where}.to", 2, coordinate=True)
+    t = r.number(w.get("thickness", WALL), f"{where}.thickness", positive=True, size=True)
+    h = r.number(w.get("height", WALL_H), f"{where}.height", positive=True, size=True)
     color = r.color(w.get("color", (0.8, 0.8, 0.75)), f"{where}.color")
     length = math.hypot(x1 - x0, y1 - y0)
     if length < 1e-6:
@@ -221,17 +279,17 @@ def _furniture(b: _Builder, r: _Reader, f, where: str) -> None:
         r.fail(f"{where}.type", f"expected \"box\" or \"cylinder\", got {json.dumps(got)}")
     kind = f["type"]
     r.keys(f, where, _BOX if kind == "box" else _CYL, ("x", "y", "size" if kind == "box" else "radius"))
-    x, y = r.number(f["x"], f"{where}.x"), r.number(f["y"], f"{where}.y")
-    h = r.number(f.get("height", 1.0), f"{where}.height", positive=True)
+    x, y = r.number(f["x"], f"{where}.x", coordinate=True), r.number(f["y"], f"{where}.y", coordinate=True)
+    h = r.number(f.get("height", 1.0), f"{where}.height", positive=True, size=True)
     color = r.color(f.get("color", (0.6, 0.6, 0.6)), f"{where}.color")
     movable = r.flag(f.get("movable", False), f"{where}.movable")
     name = r.name(f["name"], f"{where}.name") if "name" in f else None
     if kind == "box":
-        sx, sy = r.vector(f["size"], f"{where}.size", 2, positive=True)
+        sx, sy = r.vector(f["size"], f"{where}.size", 2, positive=True, size=True)
         yaw = r.number(f.get("yaw", 0.0), f"{where}.yaw")
         b.box(name or kind, x, y, sx, sy, h, color, yaw=yaw, movable=movable, name=name)
     else:
-        rad = r.number(f["radius"], f"{where}.radius", positive=True)
+        rad = r.number(f["radius"], f"{where}.radius", positive=True, size=True)
         b.cyl(name or kind, x, y, rad, h, color, movable=movable, name=name)
 
 
@@ -245,10 +303,11 @@ def _extent(shapes) -> tuple[float, float, float, float]:
 # -- checks shared by JSON and images ------------------------------------------------------------------
 def check_layout(layout: Layout, starts=None, source: str = "layout") -> Layout:
     """Validate the free space and the starts of ``layout`` (``starts`` None: sample
-    :data:`NUM_SAMPLED_STARTS` distinct ones in the largest free region) and return it with its starts."""
-    import dataclasses
+    :data:`NUM_SAMPLED_STARTS` distinct ones in the largest free region) and return it with its starts.
 
+    The extent is bounded first (:func:`check_extent`), before the grid is allocated."""
     r = _Reader(source)
+    check_extent(layout.bounds, source, "bounds")
     grid = layout_grid(layout, GRID_RESOLUTION)
     clear = grid.clearance() >= START_CLEARANCE
     # the border row and column of the grid count as outside: free space touching them is open
@@ -277,7 +336,7 @@ def check_layout(layout: Layout, starts=None, source: str = "layout") -> Layout:
     region = labels == labs[0]
     if region[0, :].any() or region[-1, :].any() or region[:, 0].any() or region[:, -1].any():
         r.fail("walls", "the free space around the starts reaches the bounds: close the building with walls")
-    return dataclasses.replace(layout, starts=tuple(tuple(float(v) for v in s) for s in starts))
+    return _with_starts(layout, starts)
 
 
 def sample_starts(grid, region: np.ndarray, n: int, separation: float = 1.0, seed: int = 0):
@@ -325,6 +384,7 @@ def read_png_mask(path: Path) -> np.ndarray:
 def _image_walls(b: _Builder, mask: np.ndarray, scale: float, source: str):
     """Dark pixels as wall boxes (runs of pixels merged into rectangles), outer walls around the image."""
     h, w = mask.shape
+    check_extent((0.0, 0.0, w * scale, h * scale), source, f"{w} x {h} pixels at metres_per_pixel {scale:g}")
     open_runs: dict[tuple[int, int], int] = {}  # (c0, c1) -> first row of a rectangle still growing
     rects = []
     for row in range(h + 1):
@@ -349,14 +409,17 @@ def _image_walls(b: _Builder, mask: np.ndarray, scale: float, source: str):
 
 
 def layout_from_image(path, metres_per_pixel: float = DEFAULT_METRES_PER_PIXEL, starts=None,
-                      name: str | None = None) -> Layout:
-    """A layout whose walls are the dark pixels of a PNG plan (starts sampled when not given)."""
+                      name: str | None = None, check_space: bool = True) -> Layout:
+    """A layout whose walls are the dark pixels of a PNG plan (starts sampled when not given;
+    ``check_space=False``: the free-space checks of :func:`check_layout` are skipped)."""
     if not (isinstance(metres_per_pixel, int | float) and metres_per_pixel > 0 and math.isfinite(metres_per_pixel)):
         raise LayoutFileError(f"{path}: metres_per_pixel must be a positive number, got {metres_per_pixel!r}")
     path = Path(path)
     b = _Builder(0)
     bounds = _image_walls(b, read_png_mask(path), float(metres_per_pixel), str(path))
     layout = Layout(name or path.stem, tuple(float(v) for v in bounds), tuple(b.shapes), (), None, None)
+    if not check_space:
+        return layout if starts is None else _with_starts(layout, starts)
     return check_layout(layout, starts, str(path))
 
 
@@ -366,13 +429,16 @@ def is_layout_file(env: str) -> bool:
     return str(env).lower().endswith((".json", ".png"))
 
 
-def load_layout(path, metres_per_pixel: float | None = None) -> Layout:
-    """A layout from a JSON description or a PNG plan (see the module docstring)."""
+def load_layout(path, metres_per_pixel: float | None = None, check_space: bool = True) -> Layout:
+    """A layout from a JSON description or a PNG plan (see the module docstring).
+
+    ``check_space=False`` reads and bounds every entry but skips the free-space and start checks
+    (:func:`check_layout`), which rasterise the building: a quick check of the file."""
     path = Path(path)
     if path.suffix.lower() == ".png":
-        return layout_from_image(path, metres_per_pixel or DEFAULT_METRES_PER_PIXEL)
+        return layout_from_image(path, metres_per_pixel or DEFAULT_METRES_PER_PIXEL, check_space=check_space)
     if path.suffix.lower() != ".json":
-        raise LayoutFileError(f"{path}: expected a .json layout or a .png plan")
+        raise LayoutFileError(f"{path}: expected a .json building or a .png plan")
     _regular_file(path)
     try:
         d = json.loads(path.read_text())
@@ -380,7 +446,7 @@ def load_layout(path, metres_per_pixel: float | None = None) -> Layout:
         raise LayoutFileError(f"{path}: not a text file") from None
     except json.JSONDecodeError as err:
         raise LayoutFileError(f"{path}: invalid JSON ({err.msg} at line {err.lineno}, column {err.colno})") from None
-    return layout_from_dict(d, str(path), path.parent)
+    return layout_from_dict(d, str(path), path.parent, check_space)
 
 
 def layout_to_dict(layout: Layout) -> dict:

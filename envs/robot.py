@@ -9,6 +9,14 @@ import numpy as np
 from .geometry import ShapeSet
 
 ROBOT_RADIUS = 0.22  # TurtleBot3 Waffle footprint (about 0.28 x 0.31 m) enclosed in a disc
+#: largest |slip| of :class:`OdometryNoise` (a fraction of the distance: 0.5 reads 1.5 m per metre);
+#: the drift studies go up to 0.15
+MAX_SLIP = 0.5
+#: largest |heading_bias| of :class:`OdometryNoise`, rad per metre travelled (about 29 degrees per
+#: metre; the drift studies go up to 0.05)
+MAX_HEADING_BIAS = 0.5
+#: largest ``trans_std`` (m per sqrt m) and ``rot_std`` (rad per sqrt m) of :class:`OdometryNoise`
+MAX_ODOMETRY_STD = 1.0
 
 
 def wrap(a):
@@ -89,6 +97,19 @@ class OdometryNoise:
     heading_bias: float = 0.0
     trans_std: float = 0.0
     rot_std: float = 0.0
+
+    def __post_init__(self):
+        limits = {"slip": (-MAX_SLIP, MAX_SLIP, "MAX_SLIP"),
+                  "heading_bias": (-MAX_HEADING_BIAS, MAX_HEADING_BIAS, "MAX_HEADING_BIAS"),
+                  "trans_std": (0.0, MAX_ODOMETRY_STD, "MAX_ODOMETRY_STD"),
+                  "rot_std": (0.0, MAX_ODOMETRY_STD, "MAX_ODOMETRY_STD")}
+        for key, (lo, hi, name) in limits.items():
+            v = getattr(self, key)
+            if isinstance(v, bool) or not isinstance(v, int | float | np.integer | np.floating):
+                raise ValueError(f"OdometryNoise.{key}: expected a number, got {v!r}")
+            if not (np.isfinite(v) and lo <= v <= hi):
+                raise ValueError(f"OdometryNoise.{key}: must be a finite number in [{lo:g}, {hi:g}] ({name}), "
+                                 f"got {v!r}")
 
 
 class Odometry:

@@ -189,6 +189,10 @@ def compile(spec: ModelSpec, prior_count: float = 1.0, max_entries: int = MAX_EN
     if isinstance(prior_count, bool) or not isinstance(prior_count, int | float | np.integer | np.floating) \
             or not np.isfinite(prior_count) or prior_count <= 0:
         raise SpecError(f"prior_count: must be a positive finite number, got {prior_count!r}")
+    cp = spec.collision_preference
+    if cp is not None and (isinstance(cp, bool) or not isinstance(cp, int | float | np.integer | np.floating)
+                           or not np.isfinite(cp)):
+        raise SpecError(f"collision_preference: must be a finite number (a log-preference) or None, got {cp!r}")
     factors, modalities = _validate_names(spec)
     try:
         return _compile(spec, factors, prior_count, max_entries)
@@ -268,6 +272,7 @@ def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, ma
             full[np.arange(n, cap), np.arange(n, cap), :] = 1.0
             pfull = None
             if counts is not None:
+                _check_counts_support(b, counts, f"pB['{fac.name}']", what)
                 pfull = np.zeros((cap, cap, u))
                 pfull[:n, :n] = counts
             B.append(DenseTransitions(full, pfull))
@@ -311,6 +316,23 @@ def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, ma
         collision_preference=spec.collision_preference,
         prior_count=prior_count,
     )
+
+
+def _check_counts_support(prob: np.ndarray, counts: np.ndarray, what: str, of: str, slots: bool = False) -> None:
+    """Refuse counts that contradict the transitions they belong to: learning sets each column of
+    ``B`` to its normalised counts (:meth:`DenseTransitions.learn`, ``learn_soft``), so a count of 0
+    where ``B`` is positive would make a transition ``B`` believes possible impossible at the first
+    update. Counts where ``B`` is 0 are a soft prior (the move becomes possible once learnt) and are
+    accepted. ``slots``: ``prob`` and ``counts`` are sparse ``(state, control, slot)`` arrays."""
+    bad = (prob > 0) & (counts <= 0)
+    if np.any(bad):
+        idx = tuple(int(i) for i in np.argwhere(bad)[0])
+        if slots:
+            at = f"state {idx[0]}, control {idx[1]}, slot {idx[2]}"
+        else:
+            at = f"next {idx[0]}, current {idx[1]}, control {idx[2]}"
+        raise SpecError(f"{what}: count 0 at ({at}) where {of} is {prob[idx]:.6g}; learning sets each column of "
+                        f"B to its normalised counts, so the counts must be positive wherever B is")
 
 
 def _check_sizes(spec: ModelSpec, factors, cap_f, cap_m, max_entries: int) -> None:
@@ -402,11 +424,13 @@ def _sparse_from_spec(raw: SparseB, fac: Factor, cap: int, counts) -> SparseTran
     out.succ[:n] = succ
     out.prob[:n] = prob
     if counts is not None and counts.shape == prob.shape:  # sparse counts, slot by slot
+        _check_counts_support(prob, counts, f"{what}.counts", what, slots=True)
         out.counts[:n] = counts
     elif counts is not None:  # dense (n, n, u) counts read at the successors
         s_idx = np.arange(n)[:, None, None]
         a_idx = np.arange(u)[None, :, None]
         out.counts[:n] = np.where(prob > 0, counts[succ, s_idx, a_idx], 0.0)
+        _check_counts_support(prob, out.counts[:n], f"pB['{fac.name}']", what, slots=True)
     if fac.stay is not None:
         stay_ok = np.all(
             np.isclose(out.prob[:n, fac.stay][np.arange(n), 0], 1.0)

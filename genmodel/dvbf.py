@@ -28,6 +28,25 @@ from .charts import chart
 from .latent_map import MAP_DIM
 
 LOG_2PI = float(np.log(2 * np.pi))
+#: bounds on the sizes of a DVBF-LM model (checked by :class:`DVBFConfig` before any array is
+#: made, so a model file cannot ask for more): map cells per side (Table II uses at most 75),
+#: dimension of a map cell (the paper's 20), LiDAR beams (20), query points per beam (12), width
+#: and depth of the emission network (64 and 2)
+MAX_MAP_SIDE = 512
+MAX_MAP_DIM = 256
+MAX_BEAMS = 4096
+MAX_RADII = 1024
+MAX_HIDDEN = 1024
+MAX_DEPTH = 8
+#: largest number of weights of the emission network (the defaults have about 20,000)
+MAX_EMISSION_PARAMS = 20_000_000
+#: largest side of the square world the map covers (the mazes are unit squares)
+MAX_EXTENT = 1000.0
+
+
+def _finite(v) -> bool:
+    return not isinstance(v, bool | np.bool_) and isinstance(v, int | float | np.integer | np.floating) \
+        and bool(np.isfinite(v))
 
 
 @dataclass(frozen=True)
@@ -52,10 +71,30 @@ class DVBFConfig:
     radii: tuple[float, ...] = field(default=(), compare=False)
 
     def __post_init__(self):
-        if self.extent <= 0 or self.map_side < 2 or self.n_beams < 1 or self.n_radii < 1:
-            raise ValueError(f"DVBFConfig: bad sizes {self}")
-        if self.sigma_e <= 0 or min(self.sigma_t) < 0:
-            raise ValueError("DVBFConfig: sigma_e must be > 0 and sigma_t >= 0")
+        for name, hi, limit in (("map_side", MAX_MAP_SIDE, "MAX_MAP_SIDE"), ("map_dim", MAX_MAP_DIM, "MAX_MAP_DIM"),
+                                ("n_beams", MAX_BEAMS, "MAX_BEAMS"), ("n_radii", MAX_RADII, "MAX_RADII"),
+                                ("hidden", MAX_HIDDEN, "MAX_HIDDEN"), ("depth", MAX_DEPTH, "MAX_DEPTH")):
+            v, lo = getattr(self, name), 2 if name == "map_side" else 1
+            if isinstance(v, bool | np.bool_) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
+                raise ValueError(f"DVBFConfig.{name}: expected an integer in {lo}..{hi} ({limit}), got {v!r}")
+        for name in ("extent", "lidar_range", "sigma_e"):
+            v = getattr(self, name)
+            if not _finite(v) or v <= 0:
+                raise ValueError(f"DVBFConfig.{name}: expected a positive finite number, got {v!r}")
+        if self.extent > MAX_EXTENT:
+            raise ValueError(f"DVBFConfig.extent: {self.extent!r} above the limit of {MAX_EXTENT:g} (MAX_EXTENT)")
+        if not (isinstance(self.sigma_t, tuple | list) and len(self.sigma_t) == 3
+                and all(_finite(v) and v >= 0 for v in self.sigma_t)):
+            raise ValueError(f"DVBFConfig.sigma_t: expected three finite numbers >= 0 (x, y, phi), "
+                             f"got {self.sigma_t!r}")
+        if not isinstance(self.radii, tuple | list) or not all(_finite(v) for v in self.radii):
+            raise ValueError(f"DVBFConfig.radii: expected finite numbers, got {self.radii!r}")
+        n_in = self.n_radii * self.map_dim
+        params = (n_in + 1) * self.hidden + (self.depth - 1) * (self.hidden + 1) * self.hidden + self.hidden + 1
+        if params > MAX_EMISSION_PARAMS:
+            raise ValueError(f"DVBFConfig: the emission network (input {n_in}, hidden {self.hidden}, depth "
+                             f"{self.depth}) has {params} parameters, above the limit of {MAX_EMISSION_PARAMS} "
+                             f"(MAX_EMISSION_PARAMS)")
         if not self.radii:
             object.__setattr__(self, "radii", tuple(np.linspace(0.0, self.lidar_range, self.n_radii).tolist()))
         elif len(self.radii) != self.n_radii:

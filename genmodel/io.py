@@ -187,6 +187,7 @@ def load(path, max_entries: int = MAX_ENTRIES) -> Model:
                              f"(this cogmap reads versions {', '.join(map(str, READABLE))})")
     if meta["version"] >= 3 and meta.get("json_sha256") != json_digest(meta):
         raise ModelFileError(f"{json_path}: edited or corrupt (its content does not match its digest)")
+    _check_fields(meta, json_path)
     if _sha256_file(npz_path) != meta.get("npz_sha256"):
         raise ModelFileError(f"{npz_path}: contents do not match {json_path.name} (truncated or corrupt)")
     try:
@@ -212,6 +213,70 @@ def load(path, max_entries: int = MAX_ENTRIES) -> Model:
         raise ModelFileError(f"{json_path.with_suffix('')}: {err}") from None
     except (KeyError, TypeError, IndexError, ValueError) as err:
         raise ModelFileError(f"{json_path}: inconsistent model description ({type(err).__name__}: {err})") from None
+
+
+#: every field of a model description: (JSON types accepted, what the message says is expected);
+#: ``sparse_A`` may be missing (version 1 files)
+_FIELDS = {
+    "factors": ((list,), "a list of factor objects"),
+    "modalities": ((list,), "a list of modality objects"),
+    "num_states": ((list,), "a list of integers"),
+    "num_obs": ((list,), "a list of integers"),
+    "capacities": ((list,), "a list of integers"),
+    "obs_capacities": ((list,), "a list of integers"),
+    "A_deps": ((list,), "a list of lists of factor indices"),
+    "sparse": ((list,), "a list of true/false, one per factor"),
+    "sparse_A": ((list,), "a list of true/false, one per modality"),
+    "arrays": ((list,), "a list of array names"),
+    "npz_sha256": ((str,), "the SHA-256 of the npz file"),
+    "prior_count": ((int, float), "a positive finite number"),
+    "collision_preference": ((int, float, type(None)), "a finite number or null"),
+    "inductive": ((dict, type(None)), "an object or null"),
+    "pose": ((dict, type(None)), "an object or null"),
+}
+_POSE_FIELDS = {"factor": ((int,), "a factor index"), "step": ((int, float), "a number"),
+                "influence_radius": ((int, float), "a number"), "sigma": ((int, float, type(None)), "a number or null")}
+
+
+def _check_fields(meta: dict, json_path: Path) -> None:
+    """Every field of the description present (``sparse_A`` from version 2) and of its JSON type,
+    the entries of its lists too, before anything is built from them."""
+    def bad(key: str, expected: str, got) -> ModelFileError:
+        return ModelFileError(f"{json_path}: field {key!r}: expected {expected}, got {json.dumps(got)[:80]}")
+
+    def typed(value, types) -> bool:
+        return isinstance(value, types) and not (isinstance(value, bool) and bool not in types)
+
+    for key, (types, expected) in _FIELDS.items():
+        if key not in meta:
+            if key == "sparse_A" and meta.get("version") == 1:
+                continue
+            raise ModelFileError(f"{json_path}: missing field {key!r} ({expected})")
+        if not typed(meta[key], types):
+            raise bad(key, expected, meta[key])
+    for key in ("factors", "modalities"):
+        for i, entry in enumerate(meta[key]):
+            if not isinstance(entry, dict):
+                raise bad(f"{key}[{i}]", "an object", entry)
+    for i, deps in enumerate(meta["A_deps"]):
+        if not isinstance(deps, list) or not all(typed(d, (int,)) for d in deps):
+            raise bad(f"A_deps[{i}]", "a list of factor indices", deps)
+    for key in ("sparse", "sparse_A"):
+        if key in meta and not all(isinstance(v, bool) for v in meta[key]):
+            raise bad(key, _FIELDS[key][1], meta[key])
+    if not all(isinstance(n, str) for n in meta["arrays"]):
+        raise bad("arrays", _FIELDS["arrays"][1], meta["arrays"])
+    if meta["pose"] is not None:
+        for key, (types, expected) in _POSE_FIELDS.items():
+            if key not in meta["pose"]:
+                raise ModelFileError(f"{json_path}: field 'pose': missing {key!r} ({expected})")
+            if not typed(meta["pose"][key], types):
+                raise bad(f"pose.{key}", expected, meta["pose"][key])
+    F, M = len(meta["factors"]), len(meta["modalities"])
+    for key, n in (("sparse", F), ("sparse_A", M), ("A_deps", M)):
+        if key in meta and len(meta[key]) != n:
+            raise ModelFileError(f"{json_path}: field {key!r}: {len(meta[key])} entries for "
+                                 f"{n} {'factors' if key == 'sparse' else 'modalities'}")
 
 
 def _int_list(meta: dict, key: str, length: int, minimum: int) -> list[int]:

@@ -334,6 +334,53 @@ def prepare(model, prior, observations, actions=None) -> Problem:
     )
 
 
+def check_possible(model, prob: Problem, scheme: str) -> None:
+    """Refuse observations that have probability 0 under the model, as exact Bayes does.
+
+    Variational schemes work with floored logarithms and would otherwise return a posterior for
+    an impossible observation. This follows which states are possible (the support of the prior,
+    pushed through ``B`` under each step's controls) and, at each step, keeps the states every
+    reporting modality gives a positive likelihood; the metric pose (a Gaussian) rules nothing
+    out. With one factor the test is exact; with several, each modality is checked against the
+    possible states of its factors (arc consistency), so every refusal is right but an
+    observation that only the joint of several modalities rules out can pass (use ``exact``).
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model.
+    prob : Problem
+        The checked inputs (:func:`prepare`).
+    scheme : str
+        Name of the scheme, for the message.
+
+    Raises
+    ------
+    InferenceError
+        ``"<scheme>: observations up to step <t> have zero probability under the model"``, the
+        message of ``exact`` and ``filter``.
+    """
+    possible = [p > 0 for p in prob.prior]
+    for t in range(prob.T):
+        if t > 0:
+            possible = [model.predict(f, s.astype(float), int(u)) > 0
+                        for f, (s, u) in enumerate(zip(possible, prob.actions[t - 1], strict=True))]
+        for ev in prob.evidence[t]:
+            if ev.name == POSE_KEY:
+                continue
+            mask = ev.lik > 0
+            for axis, f in enumerate(ev.deps):
+                shape = [1] * mask.ndim
+                shape[axis] = -1
+                mask = mask & possible[f].reshape(shape)
+            for axis, f in enumerate(ev.deps):
+                possible[f] = mask.any(axis=tuple(a for a in range(mask.ndim) if a != axis))
+            if not mask.any():
+                break
+        if not all(p.any() for p in possible):
+            raise InferenceError(f"{scheme}: observations up to step {t} have zero probability under the model")
+
+
 # -- small maths -----------------------------------------------------------------------------
 # floor_log, softmax, xlogx_sum and LOG_FLOOR: cogmap.genmodel.numerics (imported above)
 

@@ -5,6 +5,9 @@ observations up to ``t`` (and the actions between them) and returns its belief a
 state at ``t``; the reference is exact Bayes on the same prefix. ``window`` limits how many
 past steps each call sees (the scheme's own prediction from ``window`` steps back is then
 its prior), which is how an agent uses a scheme online.
+
+Each scheme is called once per step on the whole prefix, so the cost grows with the square of
+the number of steps: :data:`MAX_STEPS` bounds it (200 steps of the T-maze take about 100 s).
 """
 
 from __future__ import annotations
@@ -17,6 +20,19 @@ import numpy as np
 
 from cogmap import inference
 from cogmap.genmodel.numerics import TINY_FLOOR, floor_log
+
+#: longest sequence compared (``cogmap compare-inference --steps``, ``generate_sequence``'s ``T``):
+#: every scheme reruns on each prefix, so the cost grows with its square (1000 steps of the T-maze,
+#: about 40 minutes)
+MAX_STEPS = 1000
+#: the progress bar of :func:`compare_inference` appears once the comparison has run this many seconds
+PROGRESS_DELAY_S = 1.0
+
+
+def _check_steps(T, what: str) -> None:
+    if isinstance(T, bool) or not isinstance(T, int | np.integer) or not 1 <= T <= MAX_STEPS:
+        raise ValueError(f"{what}: expected an integer in 1..{MAX_STEPS} (MAX_STEPS: the comparison's cost grows "
+                         f"with the square of the steps), got {T!r}")
 
 
 class Row(NamedTuple):
@@ -55,7 +71,9 @@ def _sample(rng, p: np.ndarray) -> int:
 
 
 def generate_sequence(model, T: int, seed: int = 0) -> Sequence:
-    """Sample true states, observations and uniformly random actions from ``model``."""
+    """Sample true states, observations and uniformly random actions from ``model`` (``T`` at most
+    :data:`MAX_STEPS`)."""
+    _check_steps(T, "generate_sequence: T")
     rng = np.random.default_rng(seed)
     F = len(model.factors)
     s = np.array([_sample(rng, model.live_D(f)) for f in range(F)])
@@ -127,6 +145,7 @@ def compare_inference(
     true_states=None,
     window: int | None = None,
     options: dict | None = None,
+    progress: bool = False,
 ) -> list[Row]:
     """Run ``schemes`` (default: every registered one) over the sequence; one :class:`Row` each.
 
@@ -135,18 +154,31 @@ def compare_inference(
     sequence: its free energy is that of its posterior marginals over the whole sequence.
     ``options`` maps a scheme name to keyword options for it. A scheme that refuses the model
     (for example ``filter`` on several factors) gets a row with NaNs and the error message.
+    ``progress`` shows a bar on stderr (steps of every scheme) once the comparison has run
+    :data:`PROGRESS_DELAY_S` seconds. The sequence has at most :data:`MAX_STEPS` steps.
     """
+    from tqdm import tqdm
+
     names = list(inference.available()) if schemes is None else list(schemes)
     options = options or {}
     F = len(model.factors)
     prior = [model.live_D(f) for f in range(F)] if prior is None else list(prior)
     T = len(observations)
+    _check_steps(T, "compare_inference: observations (steps)")
+    bar = tqdm(total=T * (len(names) + 1), disable=not progress, delay=PROGRESS_DELAY_S, desc="compare-inference",
+               unit="step", leave=False)
     if actions is None:
         actions = [(0,) * F] * (T - 1)
     exact_fn = inference.get("exact")
-    ref = [exact_fn(model, prior, observations[: t + 1], actions[:t], smooth=False)[0] for t in range(T)]
+    ref = []
+    bar.set_postfix_str("exact (reference)")
+    for t in range(T):
+        ref.append(exact_fn(model, prior, observations[: t + 1], actions[:t], smooth=False)[0])
+        bar.update()
     rows = []
     for name in names:
+        bar.set_postfix_str(name)
+        done = bar.n
         fn = inference.get(name)
         opts = options.get(name, {})
         posts, fes, elapsed = [], [], 0.0
@@ -162,9 +194,11 @@ def compare_inference(
                 elapsed += time.perf_counter() - tic
                 posts.append([np.asarray(x) for x in q])
                 fes.append(info.free_energy)
+                bar.update()
         except (ValueError, KeyError) as err:
             nan = float("nan")
             rows.append(Row(name, nan, nan, nan, nan, str(err)))
+            bar.update(done + T - bar.n)
             continue
         fe = _window_free_energy(fn, name, model, prior, observations, actions, opts)
         kl = np.mean([_kl(ref[t][f], posts[t][f]) for t in range(T) for f in range(F)])
@@ -174,6 +208,7 @@ def compare_inference(
             target = np.array([[int(np.argmax(r[f])) for f in range(F)] for r in ref])
         hits = [int(np.argmax(posts[t][f])) == int(target[t][f]) for t in range(T) for f in range(F)]
         rows.append(Row(name, float(kl), fe, float(np.mean(hits)), 1e3 * elapsed / T))
+    bar.close()
     return rows
 
 

@@ -15,6 +15,7 @@ import numpy as np
 from .base import (
     InferenceInfo,
     check_num_iter,
+    check_possible,
     expected_loglik,
     floor_log,
     marginal_loglik,
@@ -102,10 +103,12 @@ def fpi(model, prior, observations, actions=None, *, num_iter: int = 16, tol: fl
     Raises
     ------
     InferenceError
-        If ``num_iter`` is not an integer >= 1 or the inputs are invalid.
+        If ``num_iter`` is not an integer >= 1, the inputs are invalid, or the observations have
+        zero probability under the model (:func:`~cogmap.inference.base.check_possible`).
     """
     num_iter = check_num_iter(num_iter, "fpi")
     prob = prepare(model, prior, observations, actions)
+    check_possible(model, prob, "fpi")
     qs = list(prob.prior)
     history = []
     total = 0.0

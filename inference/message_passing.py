@@ -28,6 +28,7 @@ from .base import (
     InferenceError,
     InferenceInfo,
     check_num_iter,
+    check_possible,
     dense_transition,
     floor_log,
     marginal_loglik,
@@ -86,6 +87,7 @@ def _window_scheme(kind: str):
         prob = prepare(model, prior, observations, actions)
         if window is not None and window < 1:
             raise InferenceError(f"{kind}: window must be >= 1, got {window}")
+        check_possible(model, prob, kind)
         start = 0 if window is None else max(0, prob.T - window)
         history = []
         pri = list(prob.prior)
@@ -133,7 +135,9 @@ def _window_scheme(kind: str):
     Raises
     ------
     InferenceError
-        If ``num_iter`` or ``window`` is invalid, or the inputs are (:func:`prepare`).
+        If ``num_iter`` or ``window`` is invalid, the inputs are (:func:`prepare`), or the
+        observations have zero probability under the model
+        (:func:`~cogmap.inference.base.check_possible`).
     """
     return scheme
 

@@ -31,9 +31,14 @@ def test_loop_policy_posterior_matches_pymdp_agent_over_an_episode(gamma):
     state = loop.init(model, policy_len=2, gamma=gamma, sample=False)
     prior = [jnp.asarray(model.live_D(f))[None] for f in range(2)]
     rng = np.random.default_rng(3)
-    location = 0
+    location, context = 0, int(rng.integers(2))
+
+    def draw(m):  # an outcome the model can produce at the true location and context
+        p = model.live_A(m)[:, location, context]
+        return int(rng.choice(p.size, p=p / p.sum()))
+
     for _ in range(3):
-        obs = [location, int(rng.integers(3)), int(rng.integers(2))]
+        obs = [location, draw(1), draw(2)]
         qs = agent.infer_states([jnp.array([o]) for o in obs], prior)
         q_pi, neg_efe = agent.infer_policies(qs)
         state, info = loop.step(state, obs)
@@ -74,6 +79,11 @@ def test_loop_learns_A_and_B_like_the_pure_updates():
         (dict(policy_len=0), ValueError, "policy_len"),
         (dict(objective="greedy"), ValueError, "unknown objective"),
         (dict(learn_A=True), SpecError, "learn_A needs"),
+        (dict(scheme="exact", num_iter=4), ValueError,
+         r"^inference scheme 'exact' has no option 'num_iter' \(its options: smooth, max_joint\)$"),
+        (dict(scheme="filter", tol=0.1), ValueError,
+         r"^inference scheme 'filter' has no option 'tol' \(it takes no options\)$"),
+        (dict(scheme="fpi", observations=[0]), ValueError, "'observations' is an argument of every inference scheme"),
     ],
 )
 def test_loop_refuses_bad_settings_with_a_message(kwargs, error, message):

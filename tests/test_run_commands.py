@@ -125,3 +125,82 @@ def test_an_interrupted_exploration_resumed_from_its_checkpoint_ends_as_an_unint
     names = [sorted(p.name for p in (tmp_path / run).iterdir()) for run in ("cut", "whole")]
     assert names[0] == names[1]
     assert json.loads((tmp_path / "cut" / "run.json").read_text())["resumed_at"] == [8]
+
+
+def _manifest(**edit) -> dict:
+    from dataclasses import asdict
+
+    from cogmap.agent.config import AgentConfig
+    from cogmap.envs import OdometryNoise
+
+    d = {"command": "explore", "env": "mini_warehouse", "steps": 5, "seed": 0, "patience": 20,
+         "checkpoint_every": 10, "config": AgentConfig().to_dict(), "noise": asdict(OdometryNoise())}
+    d.update(edit)
+    return d
+
+
+@pytest.mark.parametrize("edit, message", [
+    (dict(steps=-5), "steps: expected an integer in 1..100000 (MAX_DECISIONS), got -5"),
+    (dict(steps=2.5), "steps: expected an integer in 1..100000 (MAX_DECISIONS), got 2.5"),
+    (dict(seed="0"), "seed: expected an integer in 0..2147483647 (MAX_SEED), got \"0\""),
+    (dict(patience=None), "patience: expected an integer in 0..100000 (MAX_DECISIONS), got null"),
+    (dict(checkpoint_every=0), "checkpoint_every: expected an integer in 1..100000 (MAX_DECISIONS), got 0"),
+    (dict(env=5), "env: expected a string, got 5"),
+    (dict(env="cogmap/DroneField-v0"), "env: cogmap/DroneField-v0 is not a room for cogmap explore"),
+    (dict(config=[1]), "config: expected an object of AgentConfig fields, got [1]"),
+    (dict(config={"collision_preference": "low"}),
+     "config: AgentConfig.collision_preference: expected a finite number, got 'low'"),
+    (dict(config={"batch": 8}), "config: AgentConfig: unknown field(s) 'batch'"),
+    (dict(noise={"slip": -5}), "noise: OdometryNoise.slip: must be a finite number in [-0.5, 0.5] (MAX_SLIP), got -5"),
+    (dict(noise={"grip": 1}), "noise: unknown field(s) 'grip'"),
+    (dict(noise=None), "noise: expected an object of OdometryNoise fields, got null"),
+])
+def test_resume_refuses_a_run_json_field_of_the_wrong_type_or_range(capsys, tmp_path, edit, message):
+    (tmp_path / "run.json").write_text(json.dumps(_manifest(**edit)))
+    code, _, err = _run(capsys, ["explore", "--out", str(tmp_path), "--resume", "--quiet", "--time-limit", "0"])
+    assert code == 2 and err.count("\n") == 1 and "Traceback" not in err
+    assert err.strip().startswith(f"cogmap explore: error: {tmp_path}/run.json: {message}"), err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["run.json"]  # nothing written as if it had run
+
+
+def test_resume_refuses_a_missing_run_json_field(capsys, tmp_path):
+    d = _manifest()
+    del d["seed"]
+    (tmp_path / "run.json").write_text(json.dumps(d))
+    code, _, err = _run(capsys, ["explore", "--out", str(tmp_path), "--resume", "--quiet", "--time-limit", "0"])
+    assert code == 2 and err.strip().endswith(f"{tmp_path}/run.json: missing field 'seed'")
+
+
+def test_a_run_stopped_by_its_time_limit_says_what_resume_can_do_and_that_holds(capsys, tmp_path):
+    """Killed 0.3 s after the start the child has not written run.json yet (it does so first, before
+    the simulator and the agent exist): the message says --resume cannot continue it, and --resume
+    indeed refuses while --force starts it again. Had it got further, the message would promise
+    --resume, and that is checked instead."""
+    out = tmp_path / "run"
+    code, _, err = _run(capsys, ["explore", "--steps", "3", "--out", str(out), "--time-limit", "0.3", "--quiet"])
+    assert code == 2 and err.count("\n") == 1 and "exceeded the time limit of 0.3 s" in err
+    if (out / "run.json").exists():
+        assert err.strip().endswith("(--resume continues it)")
+        code, _, _ = _run(capsys, ["explore", "--out", str(out), "--resume", "--quiet", "--time-limit", "0"])
+        assert code == 0 and json.loads((out / "metrics.json").read_text())["steps"] == 3
+        return
+    assert err.strip().endswith("(--resume cannot continue it: it stopped before writing run.json; start it again "
+                                "with --force)")
+    code, _, err = _run(capsys, ["explore", "--out", str(out), "--resume", "--quiet", "--time-limit", "0"])
+    assert code == 2 and err.strip().endswith(f"{out}: no readable run.json to resume from")
+    code, _, _ = _run(capsys, ["explore", "--steps", "2", "--out", str(out), "--force", "--quiet", "--time-limit", "0"])
+    assert code == 0 and json.loads((out / "metrics.json").read_text())["steps"] == 2
+
+
+def test_a_run_stopped_before_its_first_checkpoint_resumes_from_the_start(capsys, tmp_path):
+    """run.json is written when the run starts: stopped before any checkpoint, --resume (as the
+    message of a stopped run promises) runs it from the start with its recorded settings."""
+    from cogmap.explore import resume_state
+
+    out = tmp_path / "run"
+    _interrupted_run(out, steps=3, at=1, every=10)
+    assert (out / "run.json").exists() and not (out / "checkpoint").exists()
+    assert resume_state(out) == " (--resume continues it)"
+    code, _, _ = _run(capsys, ["explore", "--out", str(out), "--resume", "--quiet", "--time-limit", "0"])
+    assert code == 0 and json.loads((out / "metrics.json").read_text())["steps"] == 3
+    assert resume_state(out).startswith(" (it had written its results")

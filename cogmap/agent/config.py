@@ -244,6 +244,7 @@ class AgentConfig:
     initial_capacity: int = 64
 
     def __post_init__(self):
+        _check_values(self)
         if self.view_bounds is not None:
             object.__setattr__(self, "view_bounds", check_bounds(self.view_bounds, "AgentConfig.view_bounds"))
 
@@ -314,6 +315,48 @@ class AgentConfig:
 
 
 _RETIRED = frozenset({"view_frontier_reach"})
+
+
+def _check_values(cfg) -> None:
+    """Refuse a field of the wrong type or a non-finite number, naming the field (``AgentConfig.x``);
+    the nested learning rates too (``AgentConfig.learning.x``)."""
+    import math
+
+    import numpy as np
+
+    def number(v) -> bool:
+        return not isinstance(v, bool | np.bool_) and isinstance(v, int | float | np.integer | np.floating)
+
+    def bad(name: str, v, expected: str):
+        raise ValueError(f"AgentConfig.{name}: expected {expected}, got {v!r}")
+
+    for f in fields(cfg):
+        v, kind, name = getattr(cfg, f.name), str(f.type), f.name
+        if name == "view_bounds":
+            continue  # checked by check_bounds
+        if name == "learning":
+            if not isinstance(v, LearningRates):
+                bad(name, v, "LearningRates")
+            for g in fields(v):
+                w = getattr(v, g.name)
+                items = w if isinstance(w, tuple) else (w,)
+                if not items or not all(number(x) and math.isfinite(x) for x in items):
+                    bad(f"learning.{g.name}", w, "finite numbers" if isinstance(w, tuple) else "a finite number")
+            continue
+        if kind == "bool":
+            if not isinstance(v, bool | np.bool_):
+                bad(name, v, "true or false")
+        elif kind == "int":
+            if isinstance(v, bool | np.bool_) or not isinstance(v, int | np.integer):
+                bad(name, v, "an integer")
+        elif kind in ("float", "float | None"):
+            if v is None and kind == "float | None":
+                continue
+            if not number(v) or not math.isfinite(v):
+                bad(name, v, "a finite number" + (" or None" if kind != "float" else ""))
+        elif kind == "str":
+            if not isinstance(v, str):
+                bad(name, v, "a string")
 
 
 def _check_keys(cls, d: dict) -> None:

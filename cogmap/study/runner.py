@@ -22,7 +22,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..argtypes import OneLineParser, positive_float, positive_int
+from ..argtypes import OneLineParser, positive_float, positive_int, seed_int
 from .config import STUDIES, run_specs, study_plan
 from .runs import execute
 from .supervisor import run_supervised
@@ -262,7 +262,8 @@ def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.Argu
     p.add_argument("--workers", type=positive_int, default=1, help="parallel runs (default: 1)")
     p.add_argument("--executor", default="local", choices=("local", "ray"))
     p.add_argument("--address", default=None, help="Ray cluster address (default: start a local Ray)")
-    p.add_argument("--seeds", type=int, nargs="*", default=None)
+    p.add_argument("--seeds", type=seed_int, nargs="+", default=None, metavar="SEED",
+                   help="run only these seeds (integers 0 .. MAX_SEED; default: the study's)")
     p.add_argument("--envs", nargs="*", default=None)
     p.add_argument("--methods", nargs="*", default=None)
     p.add_argument("--limit", type=positive_int, default=None, help="run at most this many missing runs")

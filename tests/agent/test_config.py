@@ -56,6 +56,27 @@ def test_unknown_fields_are_refused_by_name():
         AgentConfig.from_dict({"learning": {"max_conc": 3.0}})
 
 
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(collision_preference=float("nan")), "AgentConfig.collision_preference: expected a finite number, got nan"),
+    (dict(gamma=float("inf")), "AgentConfig.gamma: expected a finite number, got inf"),
+    (dict(pose_sigma=float("nan")), "AgentConfig.pose_sigma: expected a finite number or None, got nan"),
+    (dict(mcts_depth=2.5), "AgentConfig.mcts_depth: expected an integer, got 2.5"),
+    (dict(view_weighting="yes"), "AgentConfig.view_weighting: expected true or false, got 'yes'"),
+    (dict(encoder=3), "AgentConfig.encoder: expected a string, got 3"),
+    (dict(learning=LearningRates(floor=float("nan"))), "AgentConfig.learning.floor: expected a finite number"),
+    (dict(learning=LearningRates(forward=(7.0, float("inf"), 5.0, -5.0))),
+     "AgentConfig.learning.forward: expected finite numbers"),
+])
+def test_non_finite_or_mistyped_values_are_refused_naming_the_field(kwargs, message):
+    with pytest.raises(ValueError) as err:
+        AgentConfig(**kwargs)
+    assert str(err.value).startswith(message)
+    key, value = next(iter(kwargs.items()))
+    if key != "learning":  # the same from a manifest (JSON keeps NaN as NaN)
+        with pytest.raises(ValueError, match="AgentConfig." + key):
+            AgentConfig.from_dict(json.loads(json.dumps({key: value})))
+
+
 @pytest.mark.parametrize("pref", [-10.0, -2.5])
 def test_planner_uses_the_configured_collision_preference(pref):
     cfg = AgentConfig(collision_preference=pref)

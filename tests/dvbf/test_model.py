@@ -134,3 +134,73 @@ def test_marginal_likelihood_variance_matches_monte_carlo():
     total = cfg.sigma_e**2 + np.asarray(var)
     hand = np.sum(-0.5 * 0.01**2 / total - 0.5 * np.log(2 * np.pi * total))
     assert float(ll) == pytest.approx(hand, rel=1e-4)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(hidden=1e9), "DVBFConfig.hidden: expected an integer in 1..1024 (MAX_HIDDEN), got 1000000000.0"),
+    (dict(hidden=10**9), "DVBFConfig.hidden: expected an integer in 1..1024 (MAX_HIDDEN), got 1000000000"),
+    (dict(depth=0), "DVBFConfig.depth: expected an integer in 1..8 (MAX_DEPTH), got 0"),
+    (dict(map_side=10**6), "DVBFConfig.map_side: expected an integer in 2..512 (MAX_MAP_SIDE)"),
+    (dict(n_beams=True), "DVBFConfig.n_beams: expected an integer in 1..4096 (MAX_BEAMS), got True"),
+    (dict(extent=float("nan")), "DVBFConfig.extent: expected a positive finite number, got nan"),
+    (dict(sigma_t=(0.1, float("inf"), 0.1)), "DVBFConfig.sigma_t: expected three finite numbers >= 0"),
+    (dict(hidden=1024, n_radii=1024, map_dim=256), "DVBFConfig: the emission network (input 262144, hidden 1024, "
+                                                   "depth 2) has 269487105 parameters, above the limit of 20000000"),
+])
+def test_config_bounds_every_size_before_a_network_is_made(kwargs, message):
+    with pytest.raises(ValueError) as err:
+        DVBFConfig(**kwargs)
+    assert str(err.value).startswith(message), str(err.value)
+
+
+def _saved_model(tmp_path):
+    from cogmap.dvbf.run import save_params
+    from cogmap.inference.elbo import init_params
+
+    cfg = DVBFConfig(map_side=4, n_radii=3, hidden=8, depth=1)
+    save_params(init_params(cfg, jax.random.PRNGKey(0)), cfg, tmp_path)
+    with np.load(tmp_path / "model.npz") as z:
+        arrays = {k: z[k] for k in z.files}
+    return cfg, arrays
+
+
+def test_a_saved_model_loads_back(tmp_path):
+    from cogmap.dvbf.run import load_params
+
+    cfg, arrays = _saved_model(tmp_path)
+    params, back = load_params(tmp_path)
+    assert back == cfg
+    assert np.array_equal(np.asarray(params.q_map.mean), arrays["q_map/mean"])
+
+
+@pytest.mark.parametrize("case", ["nan", "shape", "missing", "extra", "hidden", "unknown field"])
+def test_a_damaged_model_file_is_refused_naming_the_array_or_field(tmp_path, case):
+    import json
+
+    from cogmap.dvbf.run import DVBFModelError, load_params
+
+    _, arrays = _saved_model(tmp_path)
+    meta = json.loads((tmp_path / "model.json").read_text())
+    if case == "nan":
+        arrays = {k: np.full_like(v, np.nan) for k, v in arrays.items()}
+        message = "has non-finite entries (NaN or infinite)"
+    elif case == "shape":
+        arrays["q_map/mean"] = arrays["q_map/mean"][:3]
+        message = "array 'q_map/mean' has shape (3, 4, 20), expected (4, 4, 20) from the configuration in model.json"
+    elif case == "missing":
+        del arrays["q_map/log_std"]
+        message = "missing array 'q_map/log_std'"
+    elif case == "extra":
+        arrays["junk"] = np.zeros(10**3)
+        message = "unexpected array 'junk'"
+    elif case == "hidden":
+        meta["config"]["hidden"] = 1e9
+        message = "model.json: config: DVBFConfig.hidden: expected an integer in 1..1024 (MAX_HIDDEN)"
+    else:
+        meta["config"]["batch"] = 8
+        message = "model.json: config: unknown field(s) 'batch'"
+    np.savez_compressed(tmp_path / "model.npz", **arrays)
+    (tmp_path / "model.json").write_text(json.dumps(meta))
+    with pytest.raises(DVBFModelError) as err:
+        load_params(tmp_path)
+    assert message in str(err.value) and "\n" not in str(err.value), str(err.value)

@@ -128,7 +128,23 @@ BAD_JSON = [
      "no free space: nowhere can a robot of radius 0.22 m stand clear of the walls"),
     ("furniture of unknown type", _edit(["furniture", 0, "type"], "sofa"),
      "furniture[0].type: expected \"box\" or \"cylinder\", got \"sofa\""),
+    # sizes are bounded before the validation grid is allocated (a 5 km square used to hang there)
+    ("walls enclosing a 5 km square", lambda d: d.update(walls=_square(5000.0), furniture=[], starts=None),
+     "walls: the building spans 5000.15 x 5000.15 m, above the limit of 100 m on a side (MAX_EXTENT_M)"),
+    ("a 3 km room", lambda d: d.update(walls=_square(3000.0), furniture=[], starts=None),
+     "walls: the building spans 3000.15 x 3000.15 m, above the limit of 100 m on a side (MAX_EXTENT_M)"),
+    ("bounds of 20,000 km", lambda d: d.update(bounds=[-1e7, -1e7, 1e7, 1e7]),
+     "bounds[0]: -1e+07 m, beyond the limit of +-10000 m (MAX_COORDINATE_M)"),
+    ("bounds of 2 km", lambda d: d.update(bounds=[-1e3, -1e3, 1e3, 1e3]),
+     "bounds: the building spans 2000 x 2000 m, above the limit of 100 m on a side (MAX_EXTENT_M)"),
+    ("a table 1 km wide", _edit(["furniture", 0, "size"], [1000.0, 1.0]),
+     "furniture[0].size[0]: 1000 m, above the limit of 100 m (MAX_EXTENT_M)"),
 ]
+
+
+def _square(side: float) -> list:
+    return [{"from": [0, 0], "to": [side, 0]}, {"from": [side, 0], "to": [side, side]},
+            {"from": [side, side], "to": [0, side]}, {"from": [0, side], "to": [0, 0]}]
 
 
 @pytest.mark.parametrize("what, edit, message", BAD_JSON, ids=[c[0] for c in BAD_JSON])
@@ -157,6 +173,37 @@ def test_bad_files_are_refused_before_reading(tmp_path):
         load_layout(tmp_path / "text.png")
 
 
+def test_a_small_plan_at_a_huge_scale_is_refused_before_allocating(tmp_path):
+    import cv2
+
+    from cogmap.envs.layout_file import MAX_EXTENT_M, MAX_GRID_CELLS, check_extent
+
+    img = np.full((20, 20), 255, np.uint8)
+    cv2.imwrite(str(tmp_path / "plan.png"), img)
+    (tmp_path / "plan.json").write_text(json.dumps({"name": "p", "image": "plan.png", "metres_per_pixel": 1e5}))
+    with pytest.raises(LayoutFileError, match=r"plan.png: 20 x 20 pixels at metres_per_pixel 100000: the building "
+                                              r"spans 2e\+06 x 2e\+06 m, above the limit of 100 m on a side"):
+        load_layout(tmp_path / "plan.json")
+    with pytest.raises(LayoutFileError, match="above the limit of 100 m"):
+        load_layout(tmp_path / "plan.png", metres_per_pixel=1e5)
+    # the grid bound: the limits agree at the validation resolution
+    check_extent((0.0, 0.0, MAX_EXTENT_M, MAX_EXTENT_M))
+    assert (MAX_EXTENT_M / 0.05) ** 2 <= MAX_GRID_CELLS
+
+
+def test_a_building_at_the_size_limit_is_validated():
+    lay = layout_from_dict({"name": "hall", "walls": _square(99.5)})
+    assert lay.bounds == pytest.approx((-0.075, -0.075, 99.575, 99.575)) and len(lay.starts) == 5
+
+
+@pytest.mark.parametrize("kind", ["corridor", "office", "L", "T", "U", "hall"])
+def test_every_procedural_building_is_within_the_limits(kind):
+    for seed in range(4):
+        lay = make_layout("building", seed, kind=kind)
+        back = layout_from_dict(json.loads(layout_to_json(lay)))
+        assert back.bounds == lay.bounds
+
+
 def test_cogmap_explore_runs_in_a_json_building(tmp_path, capsys):
     from cogmap.cli import main
 
@@ -166,3 +213,30 @@ def test_cogmap_explore_runs_in_a_json_building(tmp_path, capsys):
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["steps"] == 4 and metrics["distance_m"] > 0 and 70 < metrics["free_area_m2"] < 90
     assert json.loads((out / "run.json").read_text())["env"] == str(EXAMPLE)
+
+
+def test_before_a_run_the_file_is_read_and_bounded_and_the_building_is_validated_in_the_run(tmp_path, capsys,
+                                                                                             monkeypatch):
+    """``cogmap explore`` checks a layout file quickly in the parent (every entry read and bounded,
+    nothing rasterised); the free-space checks run in the supervised child, under --time-limit,
+    before the run writes anything."""
+    from cogmap import explore as explore_mod
+    from cogmap.cli import main
+    from cogmap.envs import layout_file
+
+    d = _room()
+    d["walls"][1]["gaps"] = [[1.0, 3.0]]  # open to the outside: only the free-space check sees it
+    path = tmp_path / "open.json"
+    path.write_text(json.dumps(d))
+    huge = tmp_path / "huge.json"
+    huge.write_text(json.dumps({"name": "huge", "walls": _square(5000.0)}))
+    with monkeypatch.context() as m:
+        m.setattr(layout_file, "layout_grid", lambda *a, **k: pytest.fail("rasterised before the run"))
+        explore_mod.check_env(str(path))
+        with pytest.raises(LayoutFileError, match="above the limit of 100 m on a side"):
+            explore_mod.check_env(str(huge))
+    out = tmp_path / "run"
+    code = main(["explore", "--env", str(path), "--out", str(out), "--quiet", "--time-limit", "120"])
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert code == 2 and err.startswith("cogmap explore: error: ") and "close the building with walls" in err
+    assert not out.exists() or not any(out.iterdir())  # refused before run.json or anything else

@@ -35,7 +35,27 @@ BAD = {
                             "B['s']: capacity shape (1000000, 1000000, 2) needs 2e+12 entries"),
     "float capacity": (dict(factors=[Factor("s", 2, 2, growable=True, capacity=8.0)]),
                        "factor 's' capacity: must be an integer"),
+    "NaN collision preference": (dict(collision_preference=float("nan")),
+                                 "collision_preference: must be a finite number (a log-preference) or None, got nan"),
+    "string collision preference": (dict(collision_preference="-10"), "collision_preference: must be a finite number"),
+    # learning sets B's columns to the normalised counts: a zero count where B is positive contradicts B
+    "pB zero where B is positive": (dict(pB={"s": np.stack([np.eye(2), np.eye(2)[::-1]], -1)}),
+                                    "pB['s']: count 0 at (next 0, current 0, control 1) where B['s'] is 1; learning "
+                                    "sets each column of B to its normalised counts, so the counts must be positive "
+                                    "wherever B is"),
+    "pB column of zeros": (dict(pB={"s": np.stack([np.eye(2), np.diag([1.0, 0.0])], -1)}),
+                           "pB['s']: count 0 at (next 1, current 1, control 1) where B['s'] is 1"),
+    "sparse counts zero where B is positive": (
+        dict(B={"s": SparseB(np.array([[[0, 1], [0, 1]], [[1, 0], [1, 0]]]), np.full((2, 2, 2), 0.5),
+                             np.array([[[1.0, 0.0], [1.0, 1.0]], [[1.0, 1.0], [1.0, 1.0]]]))}),
+        "B['s'].counts: count 0 at (state 0, control 0, slot 1) where B['s'] is 0.5"),
 }
+
+
+def test_pB_with_counts_where_B_is_zero_is_a_prior_and_accepted():
+    """pB positive where B is 0 (a soft prior, as pymdp's): the move becomes possible once learnt."""
+    model = compile(spec(pB={"s": np.stack([np.eye(2)] * 2, -1) * 2 + 0.1}))
+    assert model.live_pB(0)[1, 0, 0] == pytest.approx(0.1) and model.live_B(0)[1, 0, 0] == 0
 
 
 @pytest.mark.parametrize("case", sorted(BAD))

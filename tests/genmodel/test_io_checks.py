@@ -137,3 +137,35 @@ def test_nan_setting_in_the_description_is_refused(tmp_path):
     path = forge(tmp_path, grown_model(), meta_edit=lambda m: m.update(prior_count=float("nan")))
     with pytest.raises(ModelFileError, match="prior_count: must be a positive finite number, got nan"):
         load(path)
+
+
+def _signed(tmp_path, edit):
+    """A saved model whose description is edited and signed again (as a buggy writer would)."""
+    _, js = save(grown_model(), tmp_path / "m")
+    meta = json.loads(js.read_text())
+    edit(meta)
+    meta["json_sha256"] = json_digest(meta)
+    js.write_text(json.dumps(meta))
+    return tmp_path / "m"
+
+
+@pytest.mark.parametrize("edit, message", [
+    (lambda m: m.pop("arrays"), "missing field 'arrays' (a list of array names)"),
+    (lambda m: m.update(arrays=5), "field 'arrays': expected a list of array names, got 5"),
+    (lambda m: m.update(arrays=["A0", 3]), "field 'arrays': expected a list of array names"),
+    (lambda m: m.pop("factors"), "missing field 'factors'"),
+    (lambda m: m.update(factors={"s": 1}), "field 'factors': expected a list of factor objects"),
+    (lambda m: m.update(modalities=["o"]), "field 'modalities[0]': expected an object, got \"o\""),
+    (lambda m: m.update(A_deps=[[0.5]]), "field 'A_deps[0]': expected a list of factor indices"),
+    (lambda m: m.update(sparse=[1]), "field 'sparse': expected a list of true/false"),
+    (lambda m: m.update(sparse=[False, False]), "field 'sparse': 2 entries for 1 factors"),
+    (lambda m: m.update(prior_count="1"), "field 'prior_count': expected a positive finite number, got \"1\""),
+    (lambda m: m.update(collision_preference=[1]), "field 'collision_preference': expected a finite number or null"),
+    (lambda m: m.update(pose=3), "field 'pose': expected an object or null, got 3"),
+    (lambda m: m.update(pose={"factor": 0, "step": 1.0, "influence_radius": 1.0}), "field 'pose': missing 'sigma'"),
+    (lambda m: m.update(npz_sha256=None), "field 'npz_sha256': expected the SHA-256 of the npz file, got null"),
+])
+def test_each_field_of_the_description_is_checked_with_the_loader_error(tmp_path, edit, message):
+    with pytest.raises(ModelFileError) as err:
+        load(_signed(tmp_path, edit))
+    assert str(err.value).startswith(f"{tmp_path / 'm.json'}: {message}"), str(err.value)

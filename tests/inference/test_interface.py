@@ -139,3 +139,34 @@ def test_zero_probability_observation_reported():
     m.A[0].prob[:, :] = np.array([[1.0, 1.0], [0.0, 0.0]])
     with pytest.raises(InferenceError, match="zero probability"):
         inference.exact(m, [m.live_D(0)], [[1]])
+
+
+@pytest.mark.parametrize("scheme", ["exact", "filter", "fpi", "vmp", "mmp"])
+def test_every_scheme_refuses_an_observation_of_probability_zero_as_exact_does(scheme):
+    m = random_model(3, sizes=(2,), modalities=((0,),), obs_sizes=(2,))
+    m.A[0].prob[:, :] = np.array([[1.0, 1.0], [0.0, 0.0]])  # outcome 1 never happens
+    fn = inference.get(scheme)
+    with pytest.raises(InferenceError, match=f"^{scheme}: observations up to step 0 have zero probability under "
+                                             "the model$"):
+        fn(m, [m.live_D(0)], [[1]])
+    # possible under the prior of a later step only through B: refused at that step
+    m.A[0].prob[:, :] = np.array([[1.0, 0.0], [0.0, 1.0]])  # the outcome names the state
+    b = np.zeros_like(m.B[0].prob[:2, :2])
+    b[0, :, :] = 1.0  # every control leads to state 0
+    m.B[0].prob[:2, :2] = b
+    with pytest.raises(InferenceError, match=f"^{scheme}: observations up to step 1 have zero probability"):
+        fn(m, [m.live_D(0)], [[0], [1]], [(0,)])
+    q, _ = fn(m, [m.live_D(0)], [[1], [0]], [(0,)])  # possible: accepted
+    assert np.argmax(q[0]) == 0
+
+
+def test_a_modality_that_rules_out_every_state_of_another_factor_is_refused_by_fpi():
+    m = random_model(4, sizes=(2, 3), modalities=((0,), (0, 1)), obs_sizes=(2, 2))
+    m.A[0].prob[:, :2] = np.array([[1.0, 0.0], [0.0, 1.0]])  # outcome 0 of the first modality: state 0
+    m.A[1].prob[:, :2, :3] = 0.0
+    m.A[1].prob[0, :2, :3] = 1.0
+    m.A[1].prob[1, 1, :3], m.A[1].prob[0, 1, :3] = 1.0, 0.0  # outcome 1 of the second only from state 1
+    prior = [m.live_D(0), m.live_D(1)]
+    with pytest.raises(InferenceError, match="fpi: observations up to step 0 have zero probability"):
+        inference.fpi(m, prior, [[0, 1]])
+    inference.fpi(m, prior, [[1, 1]])
