@@ -7,7 +7,9 @@ such as a renderer that never returns, cannot be interrupted from inside), the r
 failed with the reason, and a fresh worker takes its place. A worker that dies on its own is
 reported the same way. Nothing else waits on a stuck run, so a study always finishes. Workers
 ignore Ctrl-C; the parent stops them all on any exit, Ctrl-C included (finished runs are already
-written).
+written). A worker also ends when its parent dies without stopping it (SIGKILL, a crash): the
+kernel sends it SIGKILL (Linux ``PR_SET_PDEATHSIG``), and a watchdog thread that sees its parent
+change ends it within :data:`WATCH_S` seconds on any system.
 """
 
 from __future__ import annotations
@@ -16,14 +18,38 @@ import multiprocessing as mp
 import os
 import queue as queue_mod
 import signal
+import threading
 import time
 import traceback
 from collections.abc import Callable
 
 POLL_S = 0.1
+#: how often a worker checks that its parent is alive, seconds
+WATCH_S = 0.5
+_PR_SET_PDEATHSIG = 1  # linux/prctl.h
 
 
-def _worker(fn, tasks, results) -> None:
+def _die_with_parent(parent: int) -> None:
+    """End this process when ``parent`` (the process that started it) ends, however it ends."""
+    try:
+        import ctypes
+
+        ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    except (OSError, AttributeError):  # not Linux: the watchdog below does it
+        pass
+    if os.getppid() != parent:  # the parent died before the request above
+        os._exit(1)
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(WATCH_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="parent-watchdog", daemon=True).start()
+
+
+def _worker(fn, tasks, results, parent: int) -> None:
+    _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle: it stops the workers
     while True:
         item = tasks.get()
@@ -49,7 +75,7 @@ def run_supervised(fn: Callable[[dict], dict], specs: list[dict], workers: int, 
     procs: list = []
 
     def spawn():
-        p = ctx.Process(target=_worker, args=(fn, tasks, results), daemon=True)
+        p = ctx.Process(target=_worker, args=(fn, tasks, results, os.getpid()), daemon=True)
         p.start()
         procs.append(p)
         return p

@@ -89,3 +89,59 @@ def test_ctrl_c_stops_a_study_quickly_keeps_finished_runs_and_leaves_no_process(
         time.sleep(0.2)
     else:
         pytest.fail("processes of the study are still running 15 s after Ctrl-C")
+
+
+def _children(pid: int) -> set[int]:
+    """The processes whose parent is ``pid`` (from /proc)."""
+    from pathlib import Path
+
+    found = set()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.add(int(stat.parent.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    from pathlib import Path
+
+    try:  # a zombie has finished: only its entry is left for its (new) parent to collect
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not __import__("sys").platform.startswith("linux"), reason="reads /proc")
+def test_workers_die_when_the_main_process_is_killed(tmp_path):
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    # a study's main process with two workers, each on a run of 60 s, killed with SIGKILL: it cannot
+    # stop them itself, so they must notice on their own
+    script = ("import time\nfrom cogmap.study.supervisor import run_supervised\n"
+              "run_supervised(time.sleep, [60, 60], 2, None, print, print)\n")
+    proc = subprocess.Popen([sys.executable, "-c", script], start_new_session=True)
+    deadline = time.monotonic() + 60
+    workers: set[int] = set()
+    while time.monotonic() < deadline and len(workers) < 2:
+        time.sleep(0.2)
+        workers = {c for c in _children(proc.pid) if b"spawn_main" in open(f"/proc/{c}/cmdline", "rb").read()}
+    assert len(workers) == 2, "the two workers should have started"
+    time.sleep(1.0)  # both are inside their run
+    others = _children(proc.pid) - workers
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=10)
+    deadline = time.monotonic() + 5
+    while time.monotonic() < deadline and any(_alive(p) for p in workers | others):
+        time.sleep(0.1)
+    left = [p for p in workers | others if _alive(p)]
+    for p in left:
+        os.kill(p, signal.SIGKILL)
+    assert not left, f"processes of the killed study still alive after 5 s: {left}"
