@@ -7,8 +7,10 @@ Layout of ``<out>/<study>/``::
     table.md, table.csv, *.png
 
 A run whose JSON exists is never redone, so an interrupted study resumes where it stopped.
-Executors: ``local`` (``ProcessPoolExecutor``; ``workers=1`` runs in-process) or ``ray``
-(each run a Ray task; ``ray.init(address=...)``); results are the same per seed.
+Executors: ``local`` (supervised worker processes, :mod:`.supervisor`; ``workers=1`` without a
+time limit runs in-process) or ``ray`` (each run a Ray task, :mod:`.ray_executor`;
+``ray.init(address=...)``), with the same time limit and failure records; results are the same
+per seed.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from pathlib import Path
 
 from ..argtypes import OneLineParser, positive_float, positive_int, seed_int
 from .config import STUDIES, run_specs, study_plan
+from .ray_executor import require_ray, run_ray
 from .runs import execute
 from .supervisor import run_supervised
 
@@ -62,39 +65,8 @@ def _run_local(specs, workers: int, sink, fail, time_limit: float | None) -> Non
     run_supervised(execute, specs, workers, time_limit, sink, fail)
 
 
-RAY_MISSING = "the ray executor needs Ray, which is not installed; install it with: pip install 'cogmap[ray]'"
-
-
-def require_ray():
-    """The ``ray`` module, or a one-line error saying how to install it."""
-    try:
-        import ray
-    except ImportError:
-        raise RuntimeError(RAY_MISSING) from None
-    return ray
-
-
-def _run_ray(specs, workers: int, address: str | None, sink) -> None:
-    ray = require_ray()
-
-    started = False
-    if not ray.is_initialized():
-        kw = {"include_dashboard": False, "log_to_driver": False, "ignore_reinit_error": True}
-        if address:
-            ray.init(address=address, **kw)
-        else:
-            ray.init(num_cpus=max(1, workers), **kw)
-        started = True
-    try:
-        remote = ray.remote(num_cpus=1)(execute)
-        pending = [remote.remote(s) for s in specs]
-        while pending:
-            done, pending = ray.wait(pending, num_returns=1)
-            for ref in done:
-                sink(ray.get(ref))
-    finally:
-        if started:
-            ray.shutdown()
+def _run_ray(specs, workers: int, address: str | None, sink, fail, time_limit: float | None) -> None:
+    run_ray(execute, specs, workers, address, time_limit, sink, fail)
 
 
 def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None, scale: str = "reduced",
@@ -128,9 +100,11 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     report : bool, optional
         Write the report table when there are results, default True.
     time_limit : float, optional
-        Seconds per run (local executor): each run goes to a worker process that is killed past the
-        limit; the run is recorded in ``failed/<key>.json`` with its reason, the study goes on, and a
-        later session retries it. Without it and with one worker, runs go in-process.
+        Seconds per run: each run goes to a worker process (a Ray task with the ``ray`` executor,
+        :mod:`cogmap.study.ray_executor`) that is killed past the limit; the run is recorded in
+        ``failed/<key>.json`` with its reason, the study goes on, and a later session retries it. A
+        run that raises is recorded the same way, with both executors. Without a limit and with one
+        worker, local runs go in-process.
 
     Returns
     -------
@@ -216,7 +190,7 @@ def _run_study(name, study_dir, runs_dir, plan, specs, workers, executor, addres
             if executor == "local":
                 _run_local(todo, workers, sink, fail, time_limit)
             elif executor == "ray":
-                _run_ray(todo, workers, address, sink)
+                _run_ray(todo, workers, address, sink, fail, time_limit)
             else:
                 raise ValueError("executor must be 'local' or 'ray'")
     finally:
@@ -268,8 +242,8 @@ def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.Argu
     p.add_argument("--methods", nargs="*", default=None)
     p.add_argument("--limit", type=positive_int, default=None, help="run at most this many missing runs")
     p.add_argument("--time-limit", type=positive_float, default=1800.0,
-                   help="wall-clock seconds per run (local executor) before it is stopped and recorded as "
-                        "failed (default: 1800)")
+                   help="wall-clock seconds per run before it is stopped and recorded as failed "
+                        "(default: 1800)")
     p.add_argument("--quiet", action="store_true")
     return p
 
@@ -278,7 +252,7 @@ def run_from_args(args) -> int:
     summary = run_study(args.study, args.out, seeds=args.seeds, envs=args.envs, methods=args.methods,
                         scale=args.scale, workers=args.workers, executor=args.executor, address=args.address,
                         limit=args.limit, progress=not args.quiet,
-                        time_limit=args.time_limit if args.executor == "local" else None)
+                        time_limit=args.time_limit)
     if summary.get("table"):
         print(summary["table"])
     print(f"{summary['runs']}/{summary['total']} runs in {summary['study_dir']} "
