@@ -55,6 +55,11 @@ def test_site_builds_strictly(site):
     assert (site / "api" / "genmodel" / "index.html").exists()
 
 
+def test_the_site_holds_no_build_caches(site):
+    caches = [p for p in site.rglob("*") if p.name == "__pycache__" or p.suffix in (".pyc", ".py")]
+    assert (site / "index.html").is_file() and not caches, caches[:5]
+
+
 def test_every_public_name_is_in_the_api_reference(site):
     ids: set[str] = set()
     for page in (site / "api").rglob("index.html"):
