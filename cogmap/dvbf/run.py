@@ -182,9 +182,10 @@ def load_params(out: Path):
     return eqx.combine(arr, static), cfg
 
 
-def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium"):
-    """The maze and the seeded operator traversal (with the actuation noise :data:`NOISE`) that a SLAM run
-    of ``slam_run(maze_seed, steps, seed=seed)`` filters; other localisers compared on it call this too.
+def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium",
+                   noise: ActuationNoise = NOISE):
+    """The maze and the seeded operator traversal (with actuation ``noise``, default :data:`NOISE`) that a SLAM
+    run of ``slam_run(maze_seed, steps, seed=seed)`` filters; other localisers compared on it call this too.
 
     Parameters
     ----------
@@ -196,6 +197,8 @@ def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "mod
         Seed of the traversal.
     complexity, corridor : str
         Maze family (Table II).
+    noise : ActuationNoise
+        Actuation noise of the traversal.
 
     Returns
     -------
@@ -205,12 +208,13 @@ def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "mod
         True poses, commanded controls, scans and blocked flags.
     """
     maze = make_maze(maze_seed, complexity, corridor)
-    return maze, traverse(maze, steps, seed=seed, noise=NOISE)
+    return maze, traverse(maze, steps, seed=seed, noise=noise)
 
 
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
              complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
-             pretrain_steps: int = 2000, pretrain_iters: int = 1500, offline: bool = False, **overrides) -> dict:
+             pretrain_steps: int = 2000, pretrain_iters: int = 1500, offline: bool = False,
+             noise: ActuationNoise = NOISE, **overrides) -> dict:
     """Run online SLAM (or, with ``offline``, offline SLAM: :mod:`cogmap.dvbf.offline`) on maze
     ``maze_seed`` for ``steps`` steps and write the run directory to ``out``.
 
@@ -240,6 +244,8 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
         ELBO steps of the pretraining.
     offline : bool
         Optimise all steps at once (:func:`~cogmap.dvbf.offline.offline_slam`) instead of the online sweep.
+    noise : ActuationNoise
+        Actuation noise of both traversals; the motion model's heading noise follows its ``rot_std``.
     **overrides
         :class:`SLAMConfig` fields, or :class:`~cogmap.dvbf.offline.OfflineConfig` fields with ``offline``.
 
@@ -262,12 +268,12 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    maze, tr = slam_traversal(maze_seed, steps, seed, complexity, corridor)
+    maze, tr = slam_traversal(maze_seed, steps, seed, complexity, corridor, noise)
     model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64,
-                       sigma_t=(0.0005, 0.0005, NOISE.rot_std))
+                       sigma_t=(0.0005, 0.0005, noise.rot_std))
     emission = None
     if pretrain_maze is not None:
-        first = traverse(make_maze(pretrain_maze, complexity, corridor), pretrain_steps, seed=seed + 1000, noise=NOISE)
+        first = traverse(make_maze(pretrain_maze, complexity, corridor), pretrain_steps, seed=seed + 1000, noise=noise)
         emission, _ = pretrain_emission(first.poses, first.scans, model, iters=pretrain_iters, seed=seed)
         overrides = {"freeze_emission": True, **overrides}
     if offline:
@@ -280,7 +286,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     write_manifest(out, command="dvbf slam", mode=label, maze_seed=maze_seed, complexity=complexity, corridor=corridor,
                    steps=steps, seed=seed, pretrain_maze=pretrain_maze, pretrain_steps=pretrain_steps,
                    pretrain_iters=pretrain_iters,
-                   noise=asdict(NOISE), config=config.to_json())
+                   noise=asdict(noise), config=config.to_json())
     bar = None
     if progress:
         from tqdm import tqdm
