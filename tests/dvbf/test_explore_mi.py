@@ -9,21 +9,10 @@ mean ratio; per seed it asserts that the agent stays localised, keeps off the wa
 gains information.
 """
 
-import jax
 import numpy as np
-import pytest
 
 from cogmap.dvbf.explore import STUDY_MI, ExploreConfig, explore, pretrained_emission
 from cogmap.envs.maze import make_maze
-
-
-@pytest.fixture
-def float32():
-    """Run in JAX's default precision even when another test module has switched on float64."""
-    before = jax.config.jax_enable_x64
-    jax.config.update("jax_enable_x64", False)
-    yield
-    jax.config.update("jax_enable_x64", before)
 
 
 def test_mi_agent_explores_more_than_the_random_walk_and_stays_localised(tmp_path, float32):
