@@ -42,7 +42,7 @@ def test_tiny_study_runs_resumes_and_reports(tmp_path):
     for result in by_method.values():
         curve = np.array(result["error_curve"])
         assert curve.shape == (3,) and curve[0] < 1e-2  # every 10th of 30 steps; the start is known
-        assert result["error_max"] >= curve.max() - 1e-9  # the maximum over all steps covers the sampled ones
+        assert result["error_max"] >= curve.max() - 1e-5  # covers the sampled steps (stored rounded to 5 decimals)
     assert by_method["mcl"]["error_max"] < 0.01  # the true map keeps it on track over 30 steps
     table = (tmp_path / "dvbf-slam" / "table.md").read_text()
     assert "paper: online" in table and "0.03 ± 0.02" in table and "**Target (online):**" in table
