@@ -34,6 +34,8 @@ MAZE_MAX_STEPS = 3000
 ALL_IDS = (*LAYOUT_IDS, GRID_ID)
 DRONE_ID = "cogmap/DroneField-v0"
 DRONE_MAX_STEPS = 250
+#: every id :func:`register_all` registers (users' rooms added by :func:`register_layout` are not in it)
+BUILTIN_IDS = (*LAYOUT_IDS, GRID_ID, MAZE_ID, DRONE_ID)
 
 
 def register_all() -> None:
