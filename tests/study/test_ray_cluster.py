@@ -1,7 +1,8 @@
 """The Ray executor on a real multi-process cluster on loopback (a head and a second node, each
 started by ``ray start`` as its own processes), reached through its address as ``--address`` does:
-a study completes with the same results as the local executor, a run that hangs is recorded as
-failed at its time limit and one that raises with its error, and the study goes on."""
+a study cut after one run and resumed completes with the same results as the local executor run
+without a break, a run that hangs is recorded as failed at its time limit and one that raises with
+its error, and the study goes on."""
 
 from __future__ import annotations
 
@@ -66,12 +67,20 @@ def cluster(tmp_path_factory):
         mp.undo()
 
 
-def test_a_study_through_address_matches_the_local_executor(cluster, tmp_path):
+def test_a_study_through_address_interrupted_and_resumed_matches_the_local_executor(cluster, tmp_path):
     kw = dict(scale="tiny", seeds=[0], envs=["mini_warehouse"], methods=["random", "frontier"], progress=False,
               report=False)
     run_study("exploration", tmp_path / "local", workers=1, **kw)
-    out = run_study("exploration", tmp_path / "ray", workers=2, executor="ray", address=cluster, time_limit=300, **kw)
+    ray_kw = dict(workers=2, executor="ray", address=cluster, time_limit=300, **kw)
+    first = run_study("exploration", tmp_path / "ray", limit=1, **ray_kw)  # stopped after one run, as if cut
+    assert not first["complete"] and first["runs"] == 1
+    (kept,) = (tmp_path / "ray" / "exploration" / "runs").glob("*.json")
+    stamp = kept.stat().st_mtime_ns
+    out = run_study("exploration", tmp_path / "ray", **ray_kw)  # resumed: only the missing run is made
     assert out["complete"] and not out["failed"]
+    assert kept.stat().st_mtime_ns == stamp
+    sessions = json.loads((tmp_path / "ray" / "exploration" / "study.json").read_text())["sessions"]
+    assert [s["ran"] for s in sessions] == [1, 1]
 
     def results(d):
         from cogmap.study.runs import strip_timings
