@@ -21,13 +21,28 @@ ray = pytest.importorskip("ray")
 pytest.importorskip("pybullet")
 
 from cogmap.study.ray_executor import run_ray  # noqa: E402
-from cogmap.study.runner import run_study  # noqa: E402
+from cogmap.study.runner import load_runs, run_study  # noqa: E402
+from cogmap.study.runs import strip_timings  # noqa: E402
+
+
+def _results(study_dir):
+    return {k: strip_timings(v["result"]) for k, v in load_runs(study_dir).items()}
 
 
 def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+def test_ray_executor_in_this_process_matches_the_local_one(tmp_path):
+    """Ray started by the study itself (no address). Runs before the cluster below exists, so it
+    cannot join it, and shares this file's worker with it under pytest-xdist."""
+    kw = dict(scale="tiny", seeds=[0, 1], methods=["aimapp", "frontier"], progress=False, report=False)
+    run_study("exploration", tmp_path / "local", workers=1, **kw)
+    run_study("exploration", tmp_path / "ray", workers=2, executor="ray", **kw)
+    local, ray_ = _results(tmp_path / "local" / "exploration"), _results(tmp_path / "ray" / "exploration")
+    assert len(local) == 4 and local == ray_
 
 
 @pytest.fixture(scope="module")
@@ -82,12 +97,7 @@ def test_a_study_through_address_interrupted_and_resumed_matches_the_local_execu
     sessions = json.loads((tmp_path / "ray" / "exploration" / "study.json").read_text())["sessions"]
     assert [s["ran"] for s in sessions] == [1, 1]
 
-    def results(d):
-        from cogmap.study.runs import strip_timings
-
-        return {p.name: strip_timings(json.loads(p.read_text())["result"]) for p in sorted(d.glob("runs/*.json"))}
-
-    local, remote = results(tmp_path / "local" / "exploration"), results(tmp_path / "ray" / "exploration")
+    local, remote = _results(tmp_path / "local" / "exploration"), _results(tmp_path / "ray" / "exploration")
     assert len(local) == 2 and local == remote
 
 

@@ -119,15 +119,6 @@ def test_resumed_study_gives_the_same_table_as_an_uninterrupted_one(tmp_path):
     assert not list(runs_dir.glob(".*.tmp"))
 
 
-def test_ray_executor_matches_the_local_one(tmp_path):
-    pytest.importorskip("ray")
-    kw = dict(scale="tiny", seeds=[0, 1], methods=["aimapp", "frontier"], progress=False, report=False)
-    run_study("exploration", tmp_path / "local", workers=1, **kw)
-    run_study("exploration", tmp_path / "ray", workers=2, executor="ray", **kw)
-    local, ray_ = _results(tmp_path / "local" / "exploration"), _results(tmp_path / "ray" / "exploration")
-    assert len(local) == 4 and local == ray_
-
-
 def test_cli_entry_point(tmp_path, capsys):
     code = main(["goals", "--scale", "tiny", "--seeds", "0", "--out", str(tmp_path), "--quiet"])
     assert code == 0
