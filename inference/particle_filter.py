@@ -48,7 +48,8 @@ def pf_init(particles: jax.Array, observation=None, log_likelihood: Callable | N
     """State from initial particles; weighted by the first observation when one is given."""
     k = particles.shape[0]
     if observation is None:
-        return ParticleState(particles, jnp.full((k,), -jnp.log(k)), jnp.zeros(()))
+        # weights typed as the particles (not weakly typed): a compiled filter sees the same types at every step
+        return ParticleState(particles, jnp.full((k,), -jnp.log(k), particles.dtype), jnp.zeros(()))
     log_w, log_z = normalise_log_weights(log_likelihood(particles, observation))
     return ParticleState(particles, log_w, log_z)
 

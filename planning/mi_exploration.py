@@ -232,9 +232,15 @@ def _optimise_impl(raw, z0, eps, grid, sig, extent, cfg):
     return r, before, _penalty_loss(r, z0, eps, grid, sig, extent, cfg)[1]
 
 
+@jax.jit
+def _mean_paths(controls, start):
+    return jax.vmap(lambda c: rollout(start, c))(controls)
+
+
 def mean_paths(controls, start) -> np.ndarray:
-    """Mean poses ``(F, T + 1, 3)`` of candidates ``(F, T, 2)`` rolled out from ``start (3,)``."""
-    return np.asarray(jax.vmap(lambda c: rollout(jnp.asarray(start, float), c))(jnp.asarray(controls, float)))
+    """Mean poses ``(F, T + 1, 3)`` of candidates ``(F, T, 2)`` rolled out from ``start (3,)`` (compiled once
+    per shape, not at every call)."""
+    return np.asarray(_mean_paths(jnp.asarray(controls, float), jnp.asarray(start, float)))
 
 
 def cut_forward(controls, free) -> np.ndarray:

@@ -13,6 +13,7 @@ and ``inference.elbo``.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import time
 from dataclasses import asdict, dataclass, field
@@ -315,7 +316,8 @@ class OnlineSLAM:
         if emission is not None:
             params = params._replace(emission=emission)
         self.params = params
-        self._opt, self._train_step, self._filter_chunk = _compiled(config, self.capacity)
+        # the seed is used only here, not inside the compiled functions: runs of other seeds share them
+        self._opt, self._train_step, self._filter_chunk = _compiled(dataclasses.replace(config, seed=0), self.capacity)
         self.opt_state = init_opt_state(self._opt, params)
         particles = jnp.asarray(start, float) + jnp.asarray(config.init_std) * jax.random.normal(
             k_part, (config.n_particles, 3))

@@ -134,6 +134,7 @@ def _goal_run(env, seed, explore_steps, noise=None):
         sim.close()
 
 
+@pytest.mark.heavy
 def test_goal_reaching_in_the_house_four_of_five_seeds_within_twice_astar():
     runs = [_goal_run("house", seed, 150) for seed in range(5)]
     reached = [s for _, _, s in runs if s["reached"]]
@@ -143,6 +144,7 @@ def test_goal_reaching_in_the_house_four_of_five_seeds_within_twice_astar():
     assert all(lost == 0 for _, lost, _ in runs)  # the lost test stays quiet in normal operation
 
 
+@pytest.mark.heavy
 def test_goal_reaching_with_five_percent_odometry_drift():
     from cogmap.envs import OdometryNoise
 

@@ -10,11 +10,13 @@ gains information.
 """
 
 import numpy as np
+import pytest
 
 from cogmap.dvbf.explore import STUDY_MI, ExploreConfig, explore, pretrained_emission
 from cogmap.envs.maze import make_maze
 
 
+@pytest.mark.heavy
 def test_mi_agent_explores_more_than_the_random_walk_and_stays_localised(tmp_path, float32):
     # a small emission pretraining keeps the test short; the study uses 2,000 steps and 1,500 Adam steps
     emission = pretrained_emission(tmp_path, steps=300, iters=100)

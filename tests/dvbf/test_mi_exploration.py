@@ -75,6 +75,7 @@ def _half_known_model():
     return model, emission, q
 
 
+@pytest.mark.heavy
 def test_looking_at_uncertain_cells_scores_higher():
     model, emission, q = _half_known_model()
     cfg = MIConfig(horizon=10, n_candidates=1, n_marginal=40, n_maps=8, n_per_map=20, obs_every=5)

@@ -102,6 +102,7 @@ def test_navigate_run_directory(tmp_path, small_model):
     assert len(rows) == 1 + 3 and rows[0].startswith("start,goal,model,found,success")  # learned, learned_mean, true
 
 
+@pytest.mark.heavy
 def test_navigate_run_plans_to_the_poses_of_goal_scans(tmp_path, small_model):
     maze, model = small_model
     metrics = navigate_run(maze.seed, tmp_path / "obs", pairs=2, complexity="simple", corridor="medium", model=model,
@@ -141,6 +142,7 @@ def test_study_specs_are_blocks_of_pairs():
     assert json.loads(json.dumps(full[0])) == full[0]
 
 
+@pytest.mark.heavy
 def test_pose_to_observation_study_runs_and_reports(tmp_path):
     from cogmap.study.runner import load_runs, run_study
 

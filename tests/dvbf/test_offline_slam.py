@@ -12,6 +12,7 @@ from cogmap.envs.maze_traversal import traverse
 from cogmap.genmodel.dvbf import DVBFConfig
 
 
+@pytest.mark.heavy
 def test_offline_slam_beats_path_integration():
     maze = make_maze(5, "simple", "medium")  # 0.5 x 0.5, 12 x 12 map
     cfg = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=32, sigma_t=(0.0005, 0.0005, 0.02))

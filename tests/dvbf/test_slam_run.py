@@ -12,6 +12,7 @@ from cogmap.dvbf.slam import path_integration
 from cogmap.envs.maze_sim import ActuationNoise
 
 
+@pytest.mark.heavy
 def test_slam_run_directory_and_slam_beats_path_integration(tmp_path, float32):
     """A seeded case where odometry alone drifts: heading noise 0.05 rad and 10 % stride noise per step.
 

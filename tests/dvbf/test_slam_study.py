@@ -27,6 +27,7 @@ def test_bad_input_is_refused():
         study_plan("dvbf-slam", "tiny", methods=["smoothing"])
 
 
+@pytest.mark.heavy
 def test_tiny_study_runs_resumes_and_reports(tmp_path):
     first = run_study("dvbf-slam", tmp_path, scale="tiny", progress=False)
     assert first["complete"] and first["runs"] == 3  # online, offline and the grid-MCL stand-in, one traversal

@@ -1,0 +1,23 @@
+"""Suite-wide settings: a JAX compilation cache shared by the workers, and files holding a test marked
+``heavy`` run first.
+
+The suite runs on two workers, one file at a time each (``--dist loadfile``); starting the longest files
+first keeps one worker from being left with a long file at the end while the other idles. Many tests
+compile the same functions (in both workers and in the child processes of the studies they run): the
+persistent cache in pytest's cache directory compiles each once. It stores what XLA compiled, so results
+are the same with or without it.
+"""
+
+import os
+from pathlib import Path
+
+import pytest
+
+_JAX_CACHE = Path(__file__).resolve().parents[1] / ".pytest_cache" / "jax-compilation"
+os.environ.setdefault("JAX_COMPILATION_CACHE_DIR", str(_JAX_CACHE))  # read when jax is imported, here
+os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")  # and by the child processes
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    heavy_files = {item.path for item in items if item.get_closest_marker("heavy") is not None}
+    items.sort(key=lambda item: item.path not in heavy_files)  # stable: order within a file is kept
