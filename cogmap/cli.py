@@ -110,7 +110,7 @@ def _compare(args) -> int:
 
     from cogmap.inference.compare import compare_inference, format_table, generate_sequence, load_model
 
-    model = load_model(args.model, np.random.default_rng(args.seed))
+    model = load_model(args.model, np.random.default_rng(args.seed), plugins=args.plugin)
     seq = generate_sequence(model, T=args.steps, seed=args.seed)
     rows = compare_inference(model, seq.observations, seq.actions, true_states=seq.states, progress=not args.quiet)
     print(format_table(rows))
@@ -225,7 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     c = sub.add_parser("compare-inference", help="run every registered inference scheme on one model")
     c.add_argument("--model", default="tmaze",
                    help="a built-in model (tmaze, corridor, random), a saved model (PATH of its .npz/.json) "
-                        "or a factory (module:function returning a compiled Model)")
+                        "or a factory (module:function returning a compiled Model, its module loaded with --plugin)")
     c.add_argument("--steps", type=_compare_steps, default=30,
                    help="length of the sampled sequence (default: 30; at most cogmap.inference.compare.MAX_STEPS, "
                         "1000: the cost grows with the square of the steps)")

@@ -102,11 +102,13 @@ def generate_sequence(model, T: int, seed: int = 0) -> Sequence:
     return Sequence(np.array(states), obs, actions)
 
 
-def load_model(spec: str, rng: np.random.Generator | None = None):
-    """A model for the comparison: a built-in name, a saved model's path, or ``module:function``
-    (the function gets ``rng`` if it takes an argument). Raises ValueError naming the problem."""
-    import importlib
+def load_model(spec: str, rng: np.random.Generator | None = None, plugins=()):
+    """A model for the comparison: a built-in name, a saved model's path, or ``module:function`` of one of
+    the ``plugins`` (the modules ``cogmap --plugin`` imported; the function gets ``rng`` if it takes an
+    argument). Nothing is imported here: the name only selects among those modules. Raises ValueError
+    naming the problem."""
     import inspect
+    import sys
     from pathlib import Path
 
     from cogmap.genmodel import Model
@@ -120,12 +122,13 @@ def load_model(spec: str, rng: np.random.Generator | None = None):
         return load(path)
     if ":" in spec:
         module_name, _, attr = spec.partition(":")
-        try:
-            factory = getattr(importlib.import_module(module_name), attr)
-        except ModuleNotFoundError:
-            raise ValueError(f"cannot import module '{module_name}' (from --model {spec})") from None
-        except AttributeError:
-            raise ValueError(f"module '{module_name}' has no '{attr}' (from --model {spec})") from None
+        module = sys.modules.get(module_name) if module_name in plugins else None
+        if module is None:
+            raise ValueError(f"module '{module_name}' is not a loaded plugin (from --model {spec}): "
+                             f"add --plugin {module_name}") from None
+        factory = getattr(module, attr, None)
+        if not callable(factory):
+            raise ValueError(f"module '{module_name}' has no function '{attr}' (from --model {spec})")
         takes_rng = bool(inspect.signature(factory).parameters)
         model = factory(rng) if takes_rng else factory()
         if not isinstance(model, Model):

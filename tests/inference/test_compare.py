@@ -64,3 +64,32 @@ def test_window_free_energy_of_exact_smoothed_marginals_bounds_the_evidence():
     marg = brute_force_marginals(m, prior, seq.observations, seq.actions)
     F = window_free_energy(m, prior, seq.observations, seq.actions, marg)
     assert F >= -brute_force_log_evidence(m, prior, seq.observations, seq.actions) - 1e-12
+
+
+def test_a_model_factory_comes_only_from_a_loaded_module(tmp_path, monkeypatch):
+    """``--model module:function`` selects among the modules ``--plugin`` imported; any other module's
+    name is refused and nothing is imported."""
+    import sys
+
+    import pytest
+
+    from cogmap.genmodel import Model
+    from cogmap.inference.compare import load_model
+
+    (tmp_path / "cogmap_probe_factory.py").write_text(
+        "import pathlib\npathlib.Path(__file__).with_name('imported').touch()\n"
+        "from cogmap.genmodel.demo_models import tmaze\n\ndef make():\n    return tmaze()\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "cogmap_probe_factory", raising=False)
+    with pytest.raises(ValueError, match="is not a loaded plugin .*add --plugin cogmap_probe_factory"):
+        load_model("cogmap_probe_factory:make")
+    assert not (tmp_path / "imported").exists() and "cogmap_probe_factory" not in sys.modules
+    import subprocess  # noqa: F401 - loaded, but not a plugin
+
+    with pytest.raises(ValueError, match="is not a loaded plugin"):
+        load_model("subprocess:Popen", plugins=["cogmap_probe_factory"])
+    import cogmap_probe_factory  # noqa: F401 - what --plugin does
+
+    assert isinstance(load_model("cogmap_probe_factory:make", plugins=["cogmap_probe_factory"]), Model)
+    with pytest.raises(ValueError, match="has no function 'nothing'"):
+        load_model("cogmap_probe_factory:nothing", plugins=["cogmap_probe_factory"])
