@@ -125,7 +125,7 @@ def load_model(spec: str, rng: np.random.Generator | None = None, plugins=()):
         module = sys.modules.get(module_name) if module_name in plugins else None
         if module is None:
             raise ValueError(f"module '{module_name}' is not a loaded plugin (from --model {spec}): "
-                             f"add --plugin {module_name}") from None
+                             f"add --plugin {module_name}")
         factory = getattr(module, attr, None)
         if not callable(factory):
             raise ValueError(f"module '{module_name}' has no function '{attr}' (from --model {spec})")
