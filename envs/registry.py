@@ -10,6 +10,7 @@ from collections.abc import Callable
 
 import gymnasium as gym
 
+from cogmap.genmodel import contracts
 from cogmap.genmodel.registry import check_entry, check_name
 
 from .layouts import LAYOUTS, Layout
@@ -90,7 +91,7 @@ def register_layout(name: str, factory: Callable[..., Layout], *, env_id: str | 
     """
     check_name("register_layout", name)
     check_entry("register_layout", "layout", name, factory, LAYOUTS, _BUILTIN_LAYOUTS, overwrite,
-                expected="a callable factory(seed) -> Layout", same_again=False)
+                expected="a callable factory(seed) -> Layout", same_again=False, protocol=contracts.LayoutFactory)
     if env_id is not None:
         if not isinstance(env_id, str) or not env_id:
             raise ValueError(f"register_layout('{name}'): env_id must be a non-empty string, got {env_id!r}")

@@ -6,6 +6,8 @@ from __future__ import annotations
 
 from collections.abc import Container, Mapping
 
+from .contracts import check_conforms
+
 
 def check_name(func: str, name) -> None:
     """Refuse a name that is not a non-empty string.
@@ -27,10 +29,10 @@ def check_name(func: str, name) -> None:
 
 
 def check_entry(func: str, kind: str, name: str, obj, table: Mapping, builtin: Container, overwrite: bool,
-                expected: str = "a callable", same_again: bool = True) -> None:
-    """Refuse registering ``obj`` under ``name``: not callable, a built-in name, or a taken name
-    without ``overwrite`` (registering the same object again is allowed unless ``same_again`` is
-    false).
+                expected: str = "a callable", same_again: bool = True, protocol=None) -> None:
+    """Refuse registering ``obj`` under ``name``: not callable, not conforming to its contract, a
+    built-in name, or a taken name without ``overwrite`` (registering the same object again is
+    allowed unless ``same_again`` is false).
 
     Parameters
     ----------
@@ -53,16 +55,21 @@ def check_entry(func: str, kind: str, name: str, obj, table: Mapping, builtin: C
     same_again : bool, optional
         Whether registering the very same object again under its name is accepted (default True;
         a registry whose registration has side effects, such as a Gymnasium id, passes False).
+    protocol : type, optional
+        The contract of :mod:`cogmap.genmodel.contracts` ``obj`` must meet
+        (:func:`~cogmap.genmodel.contracts.check_conforms`).
 
     Raises
     ------
     TypeError
-        ``obj`` is not callable.
+        ``obj`` is not callable, or does not meet ``protocol``.
     ValueError
         ``name`` is built in, or taken and ``overwrite`` is false.
     """
     if not callable(obj):
         raise TypeError(f"{func}('{name}'): expected {expected}, got {type(obj).__name__}")
+    if protocol is not None:
+        check_conforms(func, kind, name, obj, protocol)
     again = same_again and table.get(name) is obj
     if name in builtin and not again:
         raise ValueError(f"{func}: '{name}' is a built-in {kind}; choose another name")

@@ -4,8 +4,12 @@ Every scheme: ``posterior, info = scheme(model, prior, observations, actions=Non
 (conventions in :mod:`cogmap.inference.base`). Built-in names: ``exact``, ``filter``
 (:func:`bayes_filter`), ``fpi``, ``vmp``, ``mmp``, ``kernel``
 (:func:`kernel_filter`, the drone's Gaussian-kernel update over binned factors), ``particle_filter``
-(continuous states, jax imported on call); ``get(name)``, ``register(name, fn)``, ``available()``.
+(continuous states, jax imported on call); ``get(name)``, ``register(name, fn, accepts=...)``,
+``available()``, ``accepting(model)`` (the schemes that handle a model).
 """
+
+from cogmap.genmodel.drone_beliefs import KernelBeliefModel
+from cogmap.genmodel.model import Model
 
 from .base import (
     POSE_KEY,
@@ -24,12 +28,18 @@ from .kernel_filter import kernel_filter
 from .message_passing import mmp, vmp
 from .particle_scheme import ParticleModel, particle_filter
 from .pymdp_bridge import to_pymdp
-from .registry import available, get, register, unregister
+from .registry import accepting, accepts, available, get, register, unregister
 
-_BUILTIN = (("exact", exact), ("filter", bayes_filter), ("fpi", fpi), ("vmp", vmp), ("mmp", mmp),
-            ("kernel", kernel_filter), ("particle_filter", particle_filter))
-for _name, _fn in _BUILTIN:
-    register(_name, _fn)
+
+def _one_factor(model) -> bool:
+    return isinstance(model, Model) and len(model.factors) == 1
+
+
+_BUILTIN = (("exact", exact, Model), ("filter", bayes_filter, _one_factor), ("fpi", fpi, Model),
+            ("vmp", vmp, Model), ("mmp", mmp, Model), ("kernel", kernel_filter, KernelBeliefModel),
+            ("particle_filter", particle_filter, ParticleModel))
+for _name, _fn, _accepts in _BUILTIN:
+    register(_name, _fn, accepts=_accepts)
 
 __all__ = [
     "POSE_KEY",
@@ -37,6 +47,8 @@ __all__ = [
     "InferenceError",
     "InferenceInfo",
     "ParticleModel",
+    "accepting",
+    "accepts",
     "Problem",
     "available",
     "bayes_filter",

@@ -150,7 +150,8 @@ def compare_inference(
     options: dict | None = None,
     progress: bool = False,
 ) -> list[Row]:
-    """Run ``schemes`` (default: every registered one) over the sequence; one :class:`Row` each.
+    """Run ``schemes`` (default: every registered one that accepts ``model``,
+    :func:`cogmap.inference.accepting`) over the sequence; one :class:`Row` each.
 
     ``accuracy`` is the fraction of (step, factor) pairs whose MAP state equals
     ``true_states`` when given, else the exact MAP. Each scheme also runs once over the whole
@@ -162,7 +163,7 @@ def compare_inference(
     """
     from tqdm import tqdm
 
-    names = list(inference.available()) if schemes is None else list(schemes)
+    names = list(inference.accepting(model)) if schemes is None else list(schemes)
     options = options or {}
     F = len(model.factors)
     prior = [model.live_D(f) for f in range(F)] if prior is None else list(prior)

@@ -10,17 +10,32 @@ from __future__ import annotations
 import inspect
 from collections.abc import Callable
 
+from cogmap.genmodel.contracts import InferenceScheme, check_conforms
+
 #: the arguments every scheme takes; anything else it accepts is one of its options
 CALL = ("model", "prior", "observations", "actions")
 
 _SCHEMES: dict[str, Callable] = {}
+_ACCEPTS: dict[str, Callable[[object], bool]] = {}
 
 
-def register(name: str, fn: Callable | None = None, *, overwrite: bool = False):
+def _accepts_test(name: str, accepts) -> Callable[[object], bool]:
+    if accepts is None:
+        return lambda model: True
+    if isinstance(accepts, type) or (isinstance(accepts, tuple) and accepts
+                                     and all(isinstance(t, type) for t in accepts)):
+        return lambda model: isinstance(model, accepts)
+    if callable(accepts):
+        return accepts
+    raise TypeError(f"register('{name}'): accepts must be a model type, a tuple of types or a callable "
+                    f"accepts(model) -> bool, got {type(accepts).__name__}")
+
+
+def register(name: str, fn: Callable | None = None, *, accepts=None, overwrite: bool = False):
     """Register an inference scheme under ``name``; usable as a decorator (``@register("mine")``).
 
     A scheme is any callable ``scheme(model, prior, observations, actions=None, **options)``
-    returning ``(posterior, info)``.
+    returning ``(posterior, info)`` (:class:`cogmap.genmodel.contracts.InferenceScheme`).
 
     Parameters
     ----------
@@ -28,6 +43,10 @@ def register(name: str, fn: Callable | None = None, *, overwrite: bool = False):
         Non-empty name.
     fn : callable, optional
         The scheme; omit to get a decorator.
+    accepts : type, tuple of types or callable, optional
+        The models the scheme handles: a model type (or tuple of them), or a test
+        ``accepts(model) -> bool``. :func:`accepting` and ``compare-inference`` offer the scheme
+        only for such models. Default: every model.
     overwrite : bool, optional
         Whether to replace another scheme of the same name, default False.
 
@@ -41,17 +60,21 @@ def register(name: str, fn: Callable | None = None, *, overwrite: bool = False):
     ValueError
         For an empty name, or a name taken by another scheme without ``overwrite``.
     TypeError
-        If the scheme is not callable.
+        If the scheme is not callable, cannot be called as ``scheme(model, prior, observations)``,
+        or ``accepts`` is neither a type nor a callable.
     """
     if not isinstance(name, str) or not name:
         raise ValueError("register: name must be a non-empty string")
+    test = _accepts_test(name, accepts)
 
     def _add(f: Callable) -> Callable:
         if not callable(f):
             raise TypeError(f"register('{name}'): expected a callable, got {type(f).__name__}")
+        check_conforms("register", "inference scheme", name, f, InferenceScheme)
         if name in _SCHEMES and not overwrite and _SCHEMES[name] is not f:
             raise ValueError(f"register: a scheme named '{name}' exists (pass overwrite=True)")
         _SCHEMES[name] = f
+        _ACCEPTS[name] = test
         return f
 
     return _add if fn is None else _add(fn)
@@ -73,6 +96,7 @@ def unregister(name: str) -> None:
     if name not in _SCHEMES:
         raise KeyError(f"no inference scheme named '{name}'")
     del _SCHEMES[name]
+    _ACCEPTS.pop(name, None)
 
 
 def get(name: str) -> Callable:
@@ -108,6 +132,44 @@ def available() -> tuple[str, ...]:
         Sorted names.
     """
     return tuple(sorted(_SCHEMES))
+
+
+def accepts(name: str, model) -> bool:
+    """Whether the scheme registered under ``name`` handles ``model`` (its ``accepts``).
+
+    Parameters
+    ----------
+    name : str
+        Registered name.
+    model : object
+        A model (``Model``, ``ParticleModel``, ``KernelBeliefModel``, ...).
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    KeyError
+        If no scheme has that name.
+    """
+    get(name)
+    return bool(_ACCEPTS[name](model))
+
+
+def accepting(model) -> tuple[str, ...]:
+    """Names of the registered schemes that handle ``model`` (sorted).
+
+    Parameters
+    ----------
+    model : object
+        A model.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return tuple(n for n in available() if _ACCEPTS[n](model))
 
 
 def options(name: str) -> tuple[str, ...] | None:

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cogmap.genmodel import contracts
 from cogmap.genmodel.dirichlet import novelty
 from cogmap.genmodel.numerics import LOG_FLOOR, xlogx
 from cogmap.genmodel.registry import check_entry, check_name
@@ -304,13 +305,14 @@ def register_term(name: str, term: Term, overwrite: bool = False, *, epistemic: 
         Empty name, a built-in name (:data:`ALL_TERMS`), or a name already registered without
         ``overwrite``.
     TypeError
-        ``term`` is not callable.
+        ``term`` is not callable or cannot be called as ``term(ctx)``
+        (:class:`cogmap.genmodel.contracts.EFETerm`).
     """
     check_name("register_term", name)
     if name in ALL_TERMS:
         raise ValueError(f"register_term: '{name}' is a built-in EFE term; choose another name")
     check_entry("register_term", "term", name, term, _USER_TERMS, ALL_TERMS, overwrite,
-                expected="a callable term(ctx) -> (K,)")
+                expected="a callable term(ctx) -> (K,)", protocol=contracts.EFETerm)
     _USER_TERMS[name] = term
     _USER_EPISTEMIC.pop(name, None)
     if epistemic:

@@ -26,6 +26,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from cogmap.genmodel import contracts
 from cogmap.genmodel.registry import check_entry, check_name
 
 from .mcts import MCTSConfig
@@ -105,12 +106,14 @@ def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = 
     ValueError
         Empty name, a built-in name, or a name already taken without ``overwrite``.
     TypeError
-        ``fn`` is not callable.
+        ``fn`` is not callable or cannot be called as ``fn(model, qs, objective, settings)``
+        (:class:`cogmap.genmodel.contracts.Planner`).
     """
     check_name("register_planner", name)
 
     def _add(f: Planner) -> Planner:
-        check_entry("register_planner", "planner", name, f, _PLANNERS, BUILTIN, overwrite)
+        check_entry("register_planner", "planner", name, f, _PLANNERS, BUILTIN, overwrite,
+                    protocol=contracts.Planner)
         _PLANNERS[name] = f
         return f
 

@@ -16,57 +16,17 @@ panoramas costs a handful of OpenCV calls.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from typing import Protocol, runtime_checkable
+from collections.abc import Callable
 
 import numpy as np
 
+from cogmap.genmodel import contracts
+from cogmap.genmodel.contracts import Encoder
 from cogmap.genmodel.registry import check_entry, check_name
 
 C1 = (0.01 * 255) ** 2
 C2 = (0.03 * 255) ** 2
 BATCH = 128  # OpenCV 5 refuses GaussianBlur on more than 128 channels
-
-
-@runtime_checkable
-class Encoder(Protocol):
-    """What the agent and its run directory use of an encoder, and nothing more.
-
-    ``images`` are the stored observations in id order (a run directory saves them as image
-    files; an encoder that keeps no images gives an empty sequence). ``last_scores`` are the
-    similarities of the latest query to the stored observations it was compared with (empty
-    when nothing was compared); the agent uses their maximum to judge how familiar a view is.
-
-    Attributes
-    ----------
-    images : sequence of numpy.ndarray
-        Stored observations in id order (e.g. ``(H, W, 3)`` uint8 RGB panoramas); may be empty.
-    last_scores : numpy.ndarray
-        ``(k,)`` float similarities of the latest query to the ``k`` stored observations it was
-        compared with (higher is more similar).
-    """
-
-    images: Sequence[np.ndarray]
-    last_scores: np.ndarray
-
-    def __call__(self, image: np.ndarray) -> tuple[int, bool]:
-        """Return (observation id, whether the id is new); a new id stores the image."""
-
-    def match(self, image: np.ndarray) -> tuple[int, float]:
-        """Best stored id and its similarity score, storing nothing.
-
-        Parameters
-        ----------
-        image : numpy.ndarray
-            The query image (as the encoder takes it, e.g. an ``(H, W, 3)`` RGB panorama).
-
-        Returns
-        -------
-        id : int
-            Best stored observation id; -1 when nothing is stored.
-        score : float
-            Its similarity score (0.0 when nothing is stored).
-        """
 
 
 def check_encoder(encoder) -> None:
@@ -520,7 +480,7 @@ def register_encoder(name: str, factory: Callable | None = None, *, overwrite: b
             raise TypeError(f"register_encoder('{name}'): expected a callable factory(config) -> Encoder, got the "
                             f"encoder {type(f).__name__} itself (register lambda config: ... returning a new one)")
         check_entry("register_encoder", "encoder", name, f, _ENCODERS, _BUILTIN_ENCODERS, overwrite,
-                    expected="a callable factory(config) -> Encoder")
+                    expected="a callable factory(config) -> Encoder", protocol=contracts.EncoderFactory)
         _ENCODERS[name] = f
         return f
 

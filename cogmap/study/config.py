@@ -8,8 +8,11 @@ import json
 
 from .metrics_extra import COVERAGE_LEVEL, SuccessRule
 
-STUDIES = ("exploration", "generalisation", "success", "goals", "drift", "slip", "dropout", "obstacle",
-           "scaling", "drone", "dvbf-navigation", "dvbf-exploration", "dvbf-slam")
+# the studies of rooms explored by AIMAPP and the baselines (the drone's and DVBF-LM's studies have
+# their own plans in cogmap.study.drone and cogmap.study.dvbf_*; all are registered in
+# cogmap.study.registry)
+ROOM_STUDIES = ("exploration", "generalisation", "success", "goals", "drift", "slip", "dropout", "obstacle",
+                "scaling")
 METHODS = ("aimapp", "frontier", "frontier_paper", "nbv", "random", "oracle")
 # AIMAPP with the paper's drift correction only (at revisits of recognised places), without the
 # scan alignment at first visits (AgentConfig.track_anchors): a row of the drift study
@@ -109,29 +112,12 @@ def building_envs(count: int, first_seed: int = GENERAL_SEED0) -> list[str]:
     return [f"building:{KINDS[i % len(KINDS)]}:{first_seed + i}" for i in range(count)]
 
 
-def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
-    """Environments, methods, seeds and parameters of a study at a scale."""
-    if study not in STUDIES:
-        raise ValueError(f"unknown study {study!r}; choose from {STUDIES}")
+def room_plan(study: str, scale: str = "reduced", seeds=None, methods=None, envs=None) -> dict:
+    """Environments, methods, seeds and parameters of a room study at a scale."""
+    if study not in ROOM_STUDIES:
+        raise ValueError(f"unknown study {study!r}; choose from {ROOM_STUDIES}")
     if scale not in ("reduced", "full", "tiny"):
         raise ValueError("scale must be 'reduced', 'full' or 'tiny'")
-    if study == "drone":  # episodes in a 3D field, not rooms: its own plan (cogmap.study.drone)
-        from .drone import drone_plan
-
-        return drone_plan(scale, seeds=seeds, methods=methods, envs=envs)
-    if study == "dvbf-navigation":  # mazes and pose pairs: its own plan (cogmap.study.dvbf_navigation)
-        from .dvbf_navigation import nav_plan
-
-        return nav_plan(scale, seeds=seeds, methods=methods, envs=envs)
-
-    if study == "dvbf-exploration":  # LiDAR mazes (cogmap.study.dvbf_exploration)
-        from .dvbf_exploration import dvbf_exploration_plan
-
-        return dvbf_exploration_plan(scale, seeds=seeds, methods=methods, envs=envs)
-    if study == "dvbf-slam":  # SLAM traversals of LiDAR mazes (cogmap.study.dvbf_slam)
-        from .dvbf_slam import dvbf_slam_plan
-
-        return dvbf_slam_plan(scale, seeds=seeds, methods=methods, envs=envs)
     full = scale == "full"
     tiny = scale == "tiny"
     plan: dict = {"study": study, "scale": scale, "stop_rule": STOP_RULE, "coverage_level": COVERAGE_LEVEL,
@@ -217,30 +203,13 @@ def spec_digest(spec: dict) -> str:
     return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()[:10]
 
 
-def run_specs(plan: dict) -> list[dict]:
-    """One JSON-able spec per run. The key is readable (env, method, seed, level) plus a digest of
+def room_specs(plan: dict) -> list[dict]:
+    """One JSON-able spec per run of a room study. The key is readable (env, method, seed, level) plus a digest of
     the whole spec (study, scale, steps, noise level and its parameters, stop rule, success rule,
     method options and configuration, study parameters), so a changed setting never reuses an old
     run."""
     from cogmap.explore import layout_name
 
-    if plan["study"] == "drone":
-        from .drone import drone_specs
-
-        return drone_specs(plan)
-    if plan["study"] == "dvbf-navigation":
-        from .dvbf_navigation import nav_specs
-
-        return nav_specs(plan)
-
-    if plan["study"] == "dvbf-exploration":
-        from .dvbf_exploration import dvbf_exploration_specs
-
-        return dvbf_exploration_specs(plan)
-    if plan["study"] == "dvbf-slam":
-        from .dvbf_slam import dvbf_slam_specs
-
-        return dvbf_slam_specs(plan)
     unknown = [m for m in plan["methods"] if m not in METHOD_OPTIONS]
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; choose from {list(METHOD_OPTIONS)}")

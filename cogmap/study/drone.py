@@ -124,7 +124,7 @@ HEADER = ["method", "episodes", "success %", "collision-free success %", "stuck 
 
 
 def drone_report(study_dir: Path, plan, results) -> str:
-    from .report import _csv, _md, _plt
+    from .tables import md_table, pyplot, write_csv
 
     study_dir = Path(study_dir)
     out = []
@@ -157,19 +157,19 @@ def drone_report(study_dir: Path, plan, results) -> str:
                              _f(s["efe_us_per_candidate_median"]) if timed else "–"])
         title = ("Collisions counted, episodes go on (as the original)" if level == "continue"
                  else "Collisions end the episode (the honest setting)")
-        out.append(f"## {title}\n\n" + _md(HEADER, rows))
+        out.append(f"## {title}\n\n" + md_table(HEADER, rows))
         csv_rows += [[level, *r] for r in rows]
-    _csv(study_dir / "table.csv", ["collisions", *HEADER], csv_rows)
+    write_csv(study_dir / "table.csv", ["collisions", *HEADER], csv_rows)
     per_run = []
     for r in sorted(results, key=lambda r: (r["spec"]["level"], r["spec"]["method"], r["spec"]["seed"])):
         e, sp = r["result"], r["spec"]
         per_run.append([sp["level"], sp["method"], sp["seed"], e["outcome"], e["collisions"], e["replans"], e["steps"],
                         round(e["initial_distance"], 2), round(e["final_distance"], 2), e["fallback_steps"],
                         round(e["plan_call_median_ms"], 3)])
-    _csv(study_dir / "runs.csv", ["collisions", "method", "episode", "outcome", "collisions_count", "replans", "steps",
-                                  "initial_distance_m", "final_distance_m", "fallback_steps", "plan_call_median_ms"],
-         per_run)
-    plt = _plt()
+    write_csv(study_dir / "runs.csv", ["collisions", "method", "episode", "outcome", "collisions_count", "replans",
+                                       "steps", "initial_distance_m", "final_distance_m", "fallback_steps",
+                                       "plan_call_median_ms"], per_run)
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(plan["params"]["levels"]), figsize=(6 * len(plan["params"]["levels"]), 4),
                              squeeze=False)
     for ax, level in zip(axes[0], plan["params"]["levels"], strict=True):

@@ -117,7 +117,7 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
     from cogmap.dvbf.explore import ratio_at
     from cogmap.envs.maze import TABLE_II
 
-    from .report import _csv, _md, _plt
+    from .tables import md_table, pyplot, write_csv
 
     study_dir = Path(study_dir)
     rows, csv_rows, per_run = [], [], []
@@ -176,11 +176,11 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
     header = ["Table II row", "budget", "method", "runs", "ratio at 1/4 budget", "ratio at 1/2 budget",
               "exploration ratio at the budget (mean ± std)",
               "information gain KL(q(M) || p(M)) at the end (nats)", "planning call median (ms)"]
-    _csv(study_dir / "table.csv", ["env", "steps", "paper_steps", "tiles", "method", "runs", "ratio_mean",
+    write_csv(study_dir / "table.csv", ["env", "steps", "paper_steps", "tiles", "method", "runs", "ratio_mean",
                                    "ratio_std", "info_gain_mean", "plan_call_median_ms"], csv_rows)
-    _csv(study_dir / "runs.csv", ["env", "method", "seed", "maze_seed", "steps", "ratio", "info_gain",
+    write_csv(study_dir / "runs.csv", ["env", "method", "seed", "maze_seed", "steps", "ratio", "info_gain",
                                   "blocked_steps", "path_length"], per_run)
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, len(plan["envs"]), figsize=(4.5 * len(plan["envs"]), 3.6), squeeze=False)
     colours = {"mi": "tab:blue", "mi-pull": "tab:purple", "random": "tab:red", "frontier": "tab:green"}
     for ax, env in zip(axes[0], plan["envs"], strict=True):
@@ -239,7 +239,7 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
                       + "; ".join(f"{lv}: {won.get(lv, 'no runs')}" for lv in levels) + ").")
         target.append("\n".join(v for _, _, v in vs))
     target = "\n\n".join(target)
-    return (_md(header, rows) + "\n\n" + target + "\n\n" + note
+    return (md_table(header, rows) + "\n\n" + target + "\n\n" + note
             + "\n\n![exploration ratio](ratio.png)\n")
 
 

@@ -173,7 +173,7 @@ def run_navigation(spec: dict) -> dict:
 def nav_report(study_dir: Path, plan, results) -> str:
     from cogmap.dvbf.navigate import summarise
 
-    from .report import _csv, _md, _plt
+    from .tables import md_table, pyplot, write_csv
 
     study_dir = Path(study_dir)
     rows = []
@@ -205,12 +205,12 @@ def nav_report(study_dir: Path, plan, results) -> str:
             table.append([g, LABELS[m], t["pairs"],
                           f"{100 * t['found'] / t['pairs']:.1f}", f"{100 * t['success_rate']:.1f}", t["collided"],
                           ratio, f"{t['plan_s_median']:.2f}", f"{t['expansions_median']:.0f}"])
-    _csv(study_dir / "table.csv", header, table)
+    write_csv(study_dir / "table.csv", header, table)
     cols = list(dict.fromkeys(k for x in rows for k in x if k not in ("maze", "seed")))  # pose-to-observation adds one
-    _csv(study_dir / "pairs.csv", ["maze", "seed", *cols], [[x["maze"], x["seed"], *[x.get(k, "") for k in cols]]
+    write_csv(study_dir / "pairs.csv", ["maze", "seed", *cols], [[x["maze"], x["seed"], *[x.get(k, "") for k in cols]]
                                                              for x in rows])
     # Figure 6c: share of pairs reached within a budget of planner queries (scan evaluations)
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     for m, c in (("learned", "tab:blue"), ("learned_mean", "tab:orange"), ("true", "tab:green"),
                  ("observation", "tab:purple")):
@@ -256,12 +256,12 @@ def nav_report(study_dir: Path, plan, results) -> str:
                  f"from a {first['pose_to_observation'].get('steps')}-step traversal (a goal's scan is only found "
                  "where the map predicts it; maze 1: 20 of 25 goal poses within 0.05 from the 2,000-step map, 23 "
                  "from a 4,000-step map).\n\n" + enc)
-    return _md(header, table) + "\n\n" + note + "\n\n![success over planner queries](success.png)\n"
+    return md_table(header, table) + "\n\n" + note + "\n\n![success over planner queries](success.png)\n"
 
 
 def _encoder_table(results) -> str:
     """Per maze: goals whose pose the search put within 0.05 of the truth, and the error quantiles."""
-    from .report import _md
+    from .tables import md_table
 
     seen = {}
     for r in results:
@@ -277,7 +277,7 @@ def _encoder_table(results) -> str:
         rows.append([env, seed, f"{int((e <= 0.05).sum())} / {e.size}", f"{np.median(e):.3f}", f"{e.max():.3f}"])
     e = np.concatenate(every)
     rows.append(["all", "–", f"{int((e <= 0.05).sum())} / {e.size}", f"{np.median(e):.3f}", f"{e.max():.3f}"])
-    return _md(["maze", "seed", "goal poses found within 0.05", "median error", "max error"], rows)
+    return md_table(["maze", "seed", "goal poses found within 0.05", "median error", "max error"], rows)
 
 
 def _pooled(rows):

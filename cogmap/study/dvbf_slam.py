@@ -168,7 +168,7 @@ def _at(curve, every, step):
 
 
 def dvbf_slam_report(study_dir: Path, plan, results) -> str:
-    from .report import _csv, _md, _plt
+    from .tables import md_table, pyplot, write_csv
 
     study_dir = Path(study_dir)
     results = sorted(results, key=lambda r: (METHODS.index(r["spec"]["method"]), _maze_seed(r["spec"]["env"]),
@@ -187,7 +187,7 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
                         for c in checks[:-1]],
                       f"**{x['error_final']:.3f}** / {x['error_pi_final']:.3f}", f"{x['error_mean']:.3f}",
                       f"{x['error_max']:.3f}", f"{100 * x['better_than_pi_share']:.0f} %", f"{x['run_s']:.0f}"])
-    _csv(study_dir / "table.csv", header, table)
+    write_csv(study_dir / "table.csv", header, table)
     # path integration depends only on the traversal: take it from whichever method ran each traversal
     traversals = {(r["spec"]["env"], r["spec"]["seed"]): r["result"] for r in results}
     fin_pi = np.array([x["error_pi_final"] for x in traversals.values()])
@@ -205,7 +205,7 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
     targets = [_target(m, by_method[m], steps) for m in ("online", "offline") if by_method[m]]
     target = "\n\n".join(targets) if targets else \
         "**Target** (DVBF-LM SLAM below path integration): no online or offline runs in this study directory."
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     series = [([r["result"] for r in by_method[m]], "error_curve", LABEL[m].split(" (")[0], c)
               for m, c in (("online", "tab:blue"), ("offline", "tab:purple"), ("mcl", "tab:green")) if by_method[m]]
@@ -255,5 +255,5 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
                      "true map, which Cartographer has to build, so it is a privileged reference, not Cartographer.")
     parts.append("The shaded bands in error.png are the 25-75 % range over runs. The paper's traversals come from "
                  "human operators, ours from the seeded operator (`cogmap.envs.maze_traversal`).")
-    return (_md(summary_header, summary) + "\n\n" + target + "\n\n" + _md(header, table) + "\n\n" + " ".join(parts)
-            + "\n\n![localisation error over steps](error.png)\n")
+    return (md_table(summary_header, summary) + "\n\n" + target + "\n\n" + md_table(header, table) + "\n\n"
+            + " ".join(parts) + "\n\n![localisation error over steps](error.png)\n")

@@ -53,7 +53,7 @@ def run_ray(fn: Callable, specs: list, workers: int, address: str | None, time_l
     Parameters
     ----------
     fn : callable
-        The run (importable in the cluster's workers, e.g. :func:`cogmap.study.runs.execute`).
+        The run (importable in the cluster's workers, e.g. :func:`cogmap.study.registry.execute`).
     specs : list
         One spec per run.
     workers : int

@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
 from . import paper
 from .metrics_extra import duplicates, fraction_within, summarise
+from .tables import md_table, pyplot, write_csv
 
 METHOD_LABEL = {"aimapp": "AIMAPP", "aimapp_revisits": "AIMAPP (revisits only)",
                 "frontier": "Frontiers (nearest reachable cell)",
@@ -30,28 +30,6 @@ def _paper_pm(v, digits: int = 2) -> str:
     if v is None or v[0] is None:
         return "–"
     return f"{v[0]:.{digits}f}" + (f" ± {v[1]:.{digits}f}" if v[1] is not None else "")
-
-
-def _md(header, rows) -> str:
-    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
-    out += ["| " + " | ".join(str(c) for c in r) + " |" for r in rows]
-    return "\n".join(out)
-
-
-def _csv(path: Path, header, rows) -> None:
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(header)
-        w.writerows(rows)
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _groups(results, *keys):
@@ -184,12 +162,12 @@ def exploration_report(study_dir: Path, plan, results) -> str:
                          x["failed_moves"], ";".join(f"{e['cause']}@{e['step']}" for e in x["interventions"]),
                          x["success"], _fmt(x.get("rmse_odometry_m")), _fmt(x.get("rmse_belief_m")),
                          _fmt(x.get("decision_mean_ms"), 2), _fmt(r.get("wall_s"), 1)])
-    _csv(study_dir / "runs.csv", ["env", "method", "seed", "key", "start_pose", "trajectory_digest", "ce_at_level",
+    write_csv(study_dir / "runs.csv", ["env", "method", "seed", "key", "start_pose", "trajectory_digest", "ce_at_level",
                                   "nauc_at_level", "distance_at_level_m", "level_step", "ce_end", "nauc_end",
                                   "nauc_budget_m", "coverage_end", "distance_end_m", "steps", "ended_by_itself",
                                   "failed_moves", "interventions", "success", "rmse_odometry_m", "rmse_belief_m",
                                   "decision_mean_ms", "wall_s"], csv_rows)
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     _exploration_figures(study_dir, plan, groups)
     budgets = {env: groups[(env, m)][0]["result"]["nauc_budget_m"] for env in plan["envs"] for m in plan["methods"]
                if (env, m) in groups}
@@ -204,11 +182,11 @@ def exploration_report(study_dir: Path, plan, results) -> str:
     note = (protocol_note(plan, results, endpoint)
             + "\n\nPaper: Tables 2 and 8, CE and nAUC over five successful trials as run (Manual = human "
             "teleoperation; our oracle stands in; both frontier rows face the paper's Frontiers).")
-    return _md(header, rows) + "\n\n" + note
+    return md_table(header, rows) + "\n\n" + note
 
 
 def _exploration_figures(study_dir: Path, plan, groups) -> None:
-    plt = _plt()
+    plt = pyplot()
     envs = plan["envs"]
     level = plan.get("coverage_level", 0.9)
     ncols = len(envs) if len(envs) <= 8 else 5  # many layouts (generalisation study): a grid of panels
@@ -325,7 +303,7 @@ def generalisation_report(study_dir: Path, plan, results) -> str:
                      f"{p['success']}/{p['runs']}", _pm(p["ce"]), "–" if p["ratio"] is None else f"{p['ratio']:.2f}",
                      _pm(p["coverage"], 3), "; ".join(f"{k}: {v}" for k, v in sorted(p["reasons"].items())),
                      "–" if p["left_runs"] is None else f"{_fmt(p['left']['mean'], 1)}; {p['left_runs']}/{p['runs']}"])
-    _csv(study_dir / "pooled.csv", header, rows)
+    write_csv(study_dir / "pooled.csv", header, rows)
     verdict = ""
     aim = next((p for p in pooled if p["method"] == "aimapp"), None)
     if aim is not None:
@@ -345,13 +323,13 @@ def generalisation_report(study_dir: Path, plan, results) -> str:
     gh, gr, gv = general_goal_rows(results)
     goals = ""
     if gr:
-        _csv(study_dir / "goals.csv", gh, gr)
+        write_csv(study_dir / "goals.csv", gh, gr)
         steps = plan.get("aimapp_goals", {}).get("goal_steps", "–")
         goals = ("\n\n## Goal runs after exploring\n\nEach AIMAPP run, once its exploration ends, is localised at "
                  "its start (known, as in the goals study) and pursues the stored view whose states lie farthest "
                  f"from it, for at most {steps} decisions; executed / A* over the goals reached (A* on the true "
-                 "occupancy grid from the start to where the robot stopped).\n\n" + _md(gh, gr) + "\n\n" + gv)
-    return (intro + "\n\n## All buildings pooled\n\n" + _md(header, rows) + verdict + goals
+                 "occupancy grid from the start to where the robot stopped).\n\n" + md_table(gh, gr) + "\n\n" + gv)
+    return (intro + "\n\n## All buildings pooled\n\n" + md_table(header, rows) + verdict + goals
             + "\n\n## Per building\n\n" + table)
 
 
@@ -376,14 +354,14 @@ def success_report(study_dir: Path, plan, results) -> str:
                          _causes(rs), sum(r["failed_moves"] for r in rs),
                          f"{sum(r.get('at_level') is not None for r in rs)}/{len(rs)}",
                          "–" if ps is None else f"{ps:.2f}", "–" if pi is None else pi])
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     endpoint = ("the whole run (interventions are looked for over every decision); 'reached' counts runs whose "
                 f"coverage reached {level:.0%} at some point.")
     note = (protocol_note(plan, results, endpoint)
             + "\n\nPaper: Table 3 (success = 5 / attempts needed for five successful trials) and Table 9 "
             "(interventions over those attempts); here each run is one attempt. Bedroom/parking/aisle rows stand in "
             "for the real home/parking/warehouse.")
-    return _md(header, rows) + "\n\n" + note
+    return md_table(header, rows) + "\n\n" + note
 
 
 # ---------------------------------------------------------------------------- goals
@@ -392,7 +370,7 @@ def goals_report(study_dir: Path, plan, results) -> str:
     for r in sorted(results, key=lambda r: r["key"]):
         for g in r["result"]["goals"]:
             goals.append({"env": r["spec"]["env"], "seed": r["spec"]["seed"], **g})
-    _csv(study_dir / "runs.csv", ["env", "seed", "goal", "goal_obs", "reached", "steps", "executed_m", "astar_m",
+    write_csv(study_dir / "runs.csv", ["env", "seed", "goal", "goal_obs", "reached", "steps", "executed_m", "astar_m",
                                   "plan_m", "plr_executed_vs_astar", "plr_executed_vs_plan", "plr_plan_vs_astar"],
          [[g["env"], g["seed"], g["goal"], g["goal_obs"], g["reached"], g["steps"], _fmt(g["executed_m"], 2),
            _fmt(g["astar_m"], 2), _fmt(g["plan_m"], 2), _fmt(g["plr_executed_vs_astar"]),
@@ -404,11 +382,11 @@ def goals_report(study_dir: Path, plan, results) -> str:
                        ("plr_plan_vs_astar", "AIMAPP plan vs. A*")):
         s = summarise([g[key] for g in goals if g["reached"]])
         rows.append([label, _pm(s), "–" if s["median"] is None else f"{s['median']:.2f}", s["n"]])
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     reached = [g for g in goals if g["reached"]]
     ratios = [g["plr_executed_vs_astar"] for g in reached]
     w20, w50 = fraction_within(ratios, 1.2), fraction_within(ratios, 1.5)
-    extra = _md(["", "ours", "paper"], [
+    extra = md_table(["", "ours", "paper"], [
         ["goal runs", len(goals), paper.GOALS["runs"]],
         ["reached", f"{len(reached)}/{len(goals)}", "–"],
         ["within 20 % of A*", "–" if w20 is None else f"{w20:.2f}", paper.GOALS["within_20pct"]],
@@ -420,11 +398,11 @@ def goals_report(study_dir: Path, plan, results) -> str:
             + protocol_note(plan, results, "each goal pursuit ends when the goal is reached or after "
                             f"{plan['params'].get('goal_steps')} decisions; the exploration before it ends by the run "
                             "end rule below. PLRs over reached goals.", success=False))
-    return _md(header, rows) + "\n\n" + extra + "\n\n" + note
+    return md_table(header, rows) + "\n\n" + extra + "\n\n" + note
 
 
 def _goal_figure(study_dir, reached) -> None:
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(8, 3.4))
     a = np.array([[g["astar_m"] or np.nan, g["executed_m"]] for g in reached], float).reshape(-1, 2)
     axes[0].scatter(a[:, 0], a[:, 1], s=14)
@@ -459,7 +437,7 @@ def drift_report(study_dir: Path, plan, results) -> str:
                 _pm(summarise([r.get(k) for r in rs]), 3)
                 for k in ("rmse_belief_m", "rmse_odometry_m", "ate_per_m_belief", "ate_per_m_odometry", "coverage")]
                 + [f"{sum(r['coverage'] >= plan.get('coverage_level', 0.9) for r in rs)}/{len(rs)}"])
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     from .config import DRIFT_LEVELS
 
     endpoint = ("the end of the run; RMSE and ATE/m over every decision of all runs (successful or not; the paper "
@@ -474,7 +452,7 @@ def drift_report(study_dir: Path, plan, results) -> str:
             "place just left at every first visit (a geometric back-end, which the paper's section 5.1 names as "
             "future work); AIMAPP (revisits only) is the paper's mechanism alone.\n\n"
             + protocol_note(plan, results, endpoint))
-    return _md(header, rows) + "\n\n" + note
+    return md_table(header, rows) + "\n\n" + note
 
 
 # ---------------------------------------------------------------------------- dropout
@@ -504,7 +482,7 @@ def dropout_report(study_dir: Path, plan, results) -> str:
                          _pm(summarise([x.get("silent_decisions", 0) for x in res]), 0),
                          f"{sum(bool(x['ended_by_itself']) for x in res)}/{len(res)}",
                          f"{sum(bool(x['success']) for x in res)}/{len(res)}"])
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     endpoint = ("the end of the run (the agent's own end or the budget); loss = coverage of the same seed without a "
                 "fault minus coverage with it, in percentage points (positive: the fault cost coverage).")
     note = (f"Environment {plan['envs']}; the stream is silent for {p['fault_length']} decisions from decision "
@@ -513,12 +491,12 @@ def dropout_report(study_dir: Path, plan, results) -> str:
             "silent stream do not count toward the end of exploration, and a silent LiDAR adds no coverage. Paper "
             "(section 4.3): the agent resumed after camera, LiDAR or odometry restarts without re-initialisation "
             "(no numbers).\n\n" + protocol_note(plan, results, endpoint))
-    return _md(header, rows) + "\n\n" + note
+    return md_table(header, rows) + "\n\n" + note
 
 
 # ---------------------------------------------------------------------------- obstacle
 def obstacle_report(study_dir: Path, plan, results) -> str:
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.4))
     header = ["seed", "blocked node", "moved at step", "mean P(into node) before", "after 10 steps", "after 20 steps",
               "final", "transitions > 0.5 before → final", "failed moves"]
@@ -550,19 +528,19 @@ def obstacle_report(study_dir: Path, plan, results) -> str:
     fig.tight_layout()
     fig.savefig(study_dir / "obstacle_transitions.png", dpi=110)
     plt.close(fig)
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     note = ("Figure 8 protocol: after exploring, the movable box is scheduled onto a free node the agent knows; "
             "we track the believed probabilities of the transitions from other states into that node "
             "(mean and max over those transitions). Paper: transitions into the blocked state are suppressed "
             "over about twenty steps.\n\n"
             + protocol_note(plan, results, f"{plan['steps'].get(plan['envs'][0])} exploration decisions, then "
                             f"{plan['params'].get('after_steps')} decisions after the box moves.", success=False))
-    return _md(header, rows) + "\n\n" + note
+    return md_table(header, rows) + "\n\n" + note
 
 
 # ---------------------------------------------------------------------------- scaling
 def scaling_report(study_dir: Path, plan, results) -> str:
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
     states, ms, sizes = [], [], []
     for r in sorted(results, key=lambda r: r["key"]):
@@ -591,80 +569,10 @@ def scaling_report(study_dir: Path, plan, results) -> str:
             if sel.any():
                 rows.append([f"{lo}-{hi}", int(sel.sum()), f"{ms[sel].mean():.1f}",
                              f"{np.percentile(ms[sel], 95):.1f}"])
-    _csv(study_dir / "table.csv", header, rows)
+    write_csv(study_dir / "table.csv", header, rows)
     size_rows = [[s["step"], s["num_states"], s["num_observations"], f"{s['model_bytes'] / 1024:.1f}"]
                  for s in sizes[-6:]]
     note = ("Decision time = AIMAPPAgent.step wall clock on this machine (2 shared cores), not a Jetson Orin Nano."
             "\n\n" + protocol_note(plan, results, "every decision of each run (fixed budget).", success=False))
-    return (_md(header, rows) + "\n\n" + _md(["step", "states", "observations", "model kB"], size_rows)
+    return (md_table(header, rows) + "\n\n" + md_table(["step", "states", "observations", "model kB"], size_rows)
             + "\n\n" + note)
-
-
-REPORTS = {"exploration": exploration_report, "generalisation": generalisation_report,
-           "success": success_report, "goals": goals_report,
-           "drift": drift_report, "slip": drift_report, "dropout": dropout_report,
-           "obstacle": obstacle_report, "scaling": scaling_report}
-
-
-def _drone_report(study_dir: Path, plan, results) -> str:
-    from .drone import drone_report
-
-    return drone_report(study_dir, plan, results)
-
-
-REPORTS["drone"] = _drone_report
-
-
-def _dvbf_navigation_report(study_dir: Path, plan, results) -> str:
-    from .dvbf_navigation import nav_report
-
-    return nav_report(study_dir, plan, results)
-
-
-REPORTS["dvbf-navigation"] = _dvbf_navigation_report
-
-
-def _dvbf_exploration_report(study_dir: Path, plan, results) -> str:
-    from .dvbf_exploration import dvbf_exploration_report
-
-    return dvbf_exploration_report(study_dir, plan, results)
-
-
-REPORTS["dvbf-exploration"] = _dvbf_exploration_report
-
-
-def _dvbf_slam_report(study_dir: Path, plan, results) -> str:
-    from .dvbf_slam import dvbf_slam_report
-
-    return dvbf_slam_report(study_dir, plan, results)
-
-
-REPORTS["dvbf-slam"] = _dvbf_slam_report
-
-
-def _code_versions(results, code: str) -> str:
-    """``digest: method (runs), ...`` for the runs made with one version of the code."""
-    counts: dict[str, int] = {}
-    for r in results:
-        if r.get("code") == code:
-            m = r.get("spec", {}).get("method", "?")
-            counts[m] = counts.get(m, 0) + 1
-    return f"`{code}` " + ", ".join(f"{m} ({n} runs)" for m, n in sorted(counts.items()))
-
-
-def write_report(name: str, study_dir: Path, plan, results, meta) -> str:
-    study_dir = Path(study_dir)
-    body = REPORTS[name](study_dir, plan, results)
-    head = (f"# Study `{name}` ({plan['scale']} scale)\n\n"
-            f"{meta['runs_done']}/{meta['runs_total']} runs, commit `{meta['commit']}`, "
-            f"wall clock {meta['wall_s_total']:.0f} s over {len(meta['sessions'])} session(s) "
-            f"(sum of run times {meta['run_wall_s_total']:.0f} s).\n\n")
-    codes = sorted({r.get("code") for r in results if r.get("code")})
-    if len(codes) > 1:
-        head += (f"**Note:** the runs were made with {len(codes)} versions of the code: "
-                 + "; ".join(_code_versions(results, c) for c in codes)
-                 + ". A run is made again when its settings (its key) change, not when code it may not use "
-                 "does.\n\n")
-    text = head + body + "\n"
-    (study_dir / "table.md").write_text(text)
-    return text

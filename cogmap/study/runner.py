@@ -25,9 +25,8 @@ import time
 from pathlib import Path
 
 from ..argtypes import OneLineParser, positive_float, positive_int, seed_int
-from .config import STUDIES, run_specs, study_plan
 from .ray_executor import require_ray, run_ray
-from .runs import execute
+from .registry import execute, run_specs, studies, study_plan, write_report
 from .supervisor import run_supervised
 
 
@@ -79,8 +78,10 @@ def run_study(name: str, out_dir="results", seeds=None, envs=None, methods=None,
     Parameters
     ----------
     name : str
-        One of ``STUDIES``: ``"exploration"``, ``"success"``, ``"goals"``, ``"drift"``, ``"slip"``,
-        ``"dropout"``, ``"obstacle"``, ``"scaling"``, ``"drone"``.
+        A registered study (:func:`cogmap.study.registry.studies`): ``"exploration"``,
+        ``"success"``, ``"goals"``, ``"drift"``, ``"slip"``, ``"dropout"``, ``"obstacle"``,
+        ``"scaling"``, ``"generalisation"``, ``"drone"``, ``"dvbf-navigation"``,
+        ``"dvbf-exploration"``, ``"dvbf-slam"``, or one added with ``register_study``.
     out_dir : str or path-like, optional
         Parent directory of the study directory, default ``"results"``.
     seeds, envs, methods : sequence, optional
@@ -222,15 +223,13 @@ def _run_study(name, study_dir, runs_dir, plan, specs, workers, executor, addres
     if summary["duplicates"]:
         print(f"ERROR: the same run appears twice in a row of the table: {summary['duplicates']}", file=sys.stderr)
     if report and results:
-        from .report import write_report
-
         summary["table"] = write_report(name, study_dir, plan, results, meta)
     return summary
 
 
 def build_parser(parser: argparse.ArgumentParser | None = None) -> argparse.ArgumentParser:
     p = parser or OneLineParser(prog="cogmap reproduce", description="Reproduce a study of the paper")
-    p.add_argument("study", choices=STUDIES)
+    p.add_argument("study", choices=studies())
     p.add_argument("--out", default="results", help="output directory (default: results/)")
     p.add_argument("--scale", default="reduced", choices=("reduced", "full", "tiny"))
     p.add_argument("--workers", type=positive_int, default=1, help="parallel runs (default: 1)")

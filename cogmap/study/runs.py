@@ -7,7 +7,6 @@ from __future__ import annotations
 import copy
 import math
 import tempfile
-import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -28,14 +27,14 @@ from .metrics_extra import (
 TIMING_SUFFIXES = ("_ms", "_s", "_us")
 
 
-def _clean(x):
+def clean_json(x):
     """numpy scalars/arrays -> Python; non-finite floats -> None (strict JSON)."""
     if isinstance(x, dict):
-        return {str(k): _clean(v) for k, v in x.items()}
+        return {str(k): clean_json(v) for k, v in x.items()}
     if isinstance(x, list | tuple):
-        return [_clean(v) for v in x]
+        return [clean_json(v) for v in x]
     if isinstance(x, np.ndarray):
-        return _clean(x.tolist())
+        return clean_json(x.tolist())
     if isinstance(x, np.generic):
         x = x.item()
     if isinstance(x, float) and not math.isfinite(x):
@@ -387,37 +386,6 @@ def run_scaling(spec) -> dict:
         sim.close()
 
 
-def run_drone(spec) -> dict:
-    from .drone import run_drone as run
-
-    return run(spec)
-
-
-def run_dvbf_navigation(spec) -> dict:
-    from .dvbf_navigation import run_navigation
-
-    return run_navigation(spec)
-
-
-def run_dvbf_exploration(spec) -> dict:
-    from .dvbf_exploration import run_dvbf_exploration as run
-
-    return run(spec)
-
-
-def run_dvbf_slam(spec) -> dict:
-    from .dvbf_slam import run_dvbf_slam as run
-
-    return run(spec)
-
-
-RUNNERS = {"exploration": run_exploration, "generalisation": run_exploration, "success": run_exploration,
-           "goals": run_goals, "drift": run_drift,
-           "slip": run_drift, "dropout": run_drift, "obstacle": run_obstacle, "scaling": run_scaling,
-           "drone": run_drone, "dvbf-navigation": run_dvbf_navigation,
-           "dvbf-exploration": run_dvbf_exploration, "dvbf-slam": run_dvbf_slam}
-
-
 _DIGEST: str | None = None
 
 
@@ -439,15 +407,6 @@ def code_digest() -> str:
                 h.update(f.read_bytes())
         _DIGEST = h.hexdigest()[:16]
     return _DIGEST
-
-
-def execute(spec: dict) -> dict:
-    """Run one spec and return ``{"spec": spec, "result": ..., "wall_s": ..., "code": digest}`` (JSON-able)."""
-    code = code_digest()  # before the run: the code this process imported
-    t0 = time.perf_counter()
-    result = RUNNERS[spec["study"]](spec)
-    return _clean({"key": spec["key"], "spec": spec, "result": result, "wall_s": time.perf_counter() - t0,
-                   "code": code})
 
 
 def strip_timings(x):

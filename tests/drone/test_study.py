@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from cogmap.study.config import run_specs, study_plan
+from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import run_study
 from cogmap.study.runs import strip_timings
 

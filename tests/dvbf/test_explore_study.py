@@ -11,7 +11,7 @@ from cogmap.dvbf.explore import ExploreConfig, Frontier, explore, ratio_at, star
 from cogmap.dvbf.run import explore_run
 from cogmap.envs.maze import exploration_ratio, make_maze
 from cogmap.study import run_study
-from cogmap.study.config import run_specs, study_plan
+from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import load_runs
 
 

@@ -122,7 +122,7 @@ def test_cli_parses_dvbf_navigate():
 
 
 def test_study_specs_are_blocks_of_pairs():
-    from cogmap.study.config import run_specs, study_plan
+    from cogmap.study.registry import run_specs, study_plan
 
     full = run_specs(study_plan("dvbf-navigation", "full"))
     assert len(full) == 2 * 6 * 6  # pose-to-pose and pose-to-observation; six mazes, 600 pairs each in blocks of 100

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from cogmap.study import run_study
-from cogmap.study.config import run_specs, study_plan
+from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import load_runs
 
 

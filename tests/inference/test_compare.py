@@ -13,13 +13,17 @@ def test_harness_runs_and_exact_has_zero_kl():
     rows = compare_inference(m, seq.observations, seq.actions, true_states=seq.states)
     by = {r.scheme: r for r in rows}
     assert isinstance(rows[0], Row)
-    assert {"exact", "fpi", "vmp", "mmp", "filter"} <= set(by)
+    # by default only the schemes that accept a two-factor Model: no filter, kernel or particle rows
+    assert set(by) == {"exact", "fpi", "vmp", "mmp"} and not any(r.error for r in rows)
     assert by["exact"].kl < 1e-12
-    assert by["filter"].error and "single-factor" in by["filter"].error
     for name in ("fpi", "vmp", "mmp"):
         assert by[name].kl >= 0 and np.isfinite(by[name].free_energy)
         assert 0 <= by[name].accuracy <= 1 and by[name].ms_per_step > 0
-    table = format_table(rows)
+    assert "n/a" not in format_table(rows)
+    # a scheme named explicitly still runs, and its refusal is a row with the reason
+    asked = {r.scheme: r for r in compare_inference(m, seq.observations, seq.actions, schemes=["exact", "filter"])}
+    assert asked["filter"].error and "single-factor" in asked["filter"].error
+    table = format_table(list(asked.values()))
     assert "exact" in table and "KL" in table and "n/a" in table
 
 

@@ -6,7 +6,8 @@ import numpy as np
 
 from cogmap.agent.liveness import reachable_mask
 from cogmap.envs.buildings import KINDS
-from cogmap.study.config import building_envs, run_specs, study_plan
+from cogmap.study.config import building_envs
+from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import run_study
 
 

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from cogmap.study import main, run_study
-from cogmap.study.config import run_specs, study_plan
+from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import load_runs
 from cogmap.study.runs import strip_timings
 
@@ -136,9 +136,9 @@ def test_dropout_study_pairs_each_fault_with_the_same_seed_without_one(tmp_path)
 
 
 def test_a_table_names_which_methods_each_version_of_the_code_made():
-    from cogmap.study.report import _code_versions
+    from cogmap.study.registry import code_versions
 
     results = [{"code": "aa", "spec": {"method": "aimapp"}}, {"code": "aa", "spec": {"method": "aimapp"}},
                {"code": "bb", "spec": {"method": "oracle"}}, {"code": "bb", "spec": {"method": "frontier"}}]
-    assert _code_versions(results, "aa") == "`aa` aimapp (2 runs)"
-    assert _code_versions(results, "bb") == "`bb` frontier (1 runs), oracle (1 runs)"
+    assert code_versions(results, "aa") == "`aa` aimapp (2 runs)"
+    assert code_versions(results, "bb") == "`bb` frontier (1 runs), oracle (1 runs)"
