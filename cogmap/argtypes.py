@@ -134,3 +134,13 @@ class OneLineParser(argparse.ArgumentParser):
 
     def error(self, message: str):  # noqa: D401 - argparse API
         self.exit(2, f"{self.prog}: error: {' '.join(message.split())}\n")
+
+
+def one_line(err: BaseException) -> str:
+    """An error as one line: its message (its type too when the message alone is unclear)."""
+    text = " ".join(str(err).split())
+    if isinstance(err, OSError) and err.filename is not None and err.strerror:
+        return f"{err.filename}: {err.strerror}"
+    if isinstance(err, ValueError | RuntimeError | OSError) and text:
+        return text
+    return f"{type(err).__name__}: {text}" if text else type(err).__name__

@@ -129,13 +129,13 @@ def _exploration_schema() -> Struct:
     from cogmap.agent.config import AgentConfig
     from cogmap.agent.correction import Anchor
     from cogmap.agent.encoder import SSIMEncoder
+    from cogmap.agent.exploration_end import Done
     from cogmap.agent.viewmap import ViewMap
     from cogmap.envs.robot import Odometry, OdometryNoise
     from cogmap.envs.sensors import STREAMS, FaultSchedule
     from cogmap.inference.se2 import SE2
     from cogmap.planning.sensed import SensedGrid
 
-    from .explore import Done
     from .harness import Episode
 
     count, index, state = s.Int(0), s.Int(-1), s.Int(0)

@@ -23,6 +23,7 @@ from .argtypes import (
     OneLineParser,
     bounded_float,
     bounded_int,
+    one_line,
     seed_int,
 )
 from .runguard import add_run_options, run_command
@@ -306,16 +307,6 @@ def build_parser() -> argparse.ArgumentParser:
     study_arguments(r)
     r.set_defaults(func=_reproduce)
     return p
-
-
-def one_line(err: BaseException) -> str:
-    """An error as one line: its message (its type too when the message alone is unclear)."""
-    text = " ".join(str(err).split())
-    if isinstance(err, OSError) and err.filename is not None and err.strerror:
-        return f"{err.filename}: {err.strerror}"
-    if isinstance(err, ValueError | RuntimeError | OSError) and text:
-        return text
-    return f"{type(err).__name__}: {text}" if text else type(err).__name__
 
 
 def main(argv=None) -> int:

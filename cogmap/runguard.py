@@ -154,7 +154,7 @@ def _child(spec: dict) -> dict:
 
     from tqdm import tqdm
 
-    from .cli import one_line
+    from .argtypes import one_line
 
     # a thread lock for the progress bars: tqdm's default includes a semaphore that a killed child
     # would leave registered (the resource tracker then warns at exit)

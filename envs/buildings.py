@@ -6,7 +6,7 @@ corridor or hall, which may be L, T or U shaped, one per room). Walls follow eve
 two labels or between a label and the outside (so no wall is drawn twice); a room's wall to the
 corridor gets a doorless opening of ``OPENING`` (1.6 m) metres, rooms do not open into each other.
 Walls, furniture and textures come from the same primitives as the shipped layouts
-(:class:`cogmap.envs.layouts._Builder`). Each layout is checked like a user's own building
+(:class:`cogmap.envs.layout_builder.Builder`). Each layout is checked like a user's own building
 (:func:`cogmap.envs.layout_file.check_layout`: one free region that holds every start, closed to
 the outside) and carries at least :data:`MIN_STARTS` distinct start poses (corridor points and room
 centres, at least 1 m apart).
@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .layouts import OPENING, WALL, Layout, _Builder
+from .layout_builder import OPENING, WALL, Builder, Layout
 
 KINDS = ("corridor", "office", "L", "T", "U", "hall")
 U = 0.1  # lattice step (m): every wall lies on a multiple of it
@@ -101,7 +101,7 @@ def _q(v: float) -> float:
     return round(v / U) * U
 
 
-def _walls(b: _Builder, plan: _Plan, colors: dict[int, tuple]) -> None:
+def _walls(b: Builder, plan: _Plan, colors: dict[int, tuple]) -> None:
     """Walls on every label boundary; a door where a room meets the corridor."""
     g, ox, oy = plan.grid()
     rng = plan.rng
@@ -136,7 +136,7 @@ def _walls(b: _Builder, plan: _Plan, colors: dict[int, tuple]) -> None:
                     b.vwall(line, start - WALL / 2, end + WALL / 2, gaps, color=color)
 
 
-def _furnish_room(b: _Builder, room: dict) -> None:
+def _furnish_room(b: Builder, room: dict) -> None:
     """A desk or a cabinet against the wall opposite the door, a chair or a plant in a corner."""
     x0, y0, x1, y1 = room["rect"]
     rng = b.rng
@@ -256,7 +256,7 @@ def _hall(plan: _Plan, rng) -> tuple[float, float, float, float]:
     return (0.0, 0.0, wx, wy)
 
 
-def _furnish_open(b: _Builder, rect, rng, tables: int) -> list[tuple[float, float]]:
+def _furnish_open(b: Builder, rect, rng, tables: int) -> list[tuple[float, float]]:
     """Tables with chairs and a few pillars on a coarse lattice of an open area, leaving >= 1.8 m
     walkways; returns free points between them (start candidates)."""
     x0, y0, x1, y1 = rect
@@ -284,7 +284,7 @@ def building(seed: int = 0, kind: str = "office") -> Layout:
 
     if kind not in KINDS:
         raise ValueError(f"unknown building kind {kind!r}; use one of {list(KINDS)}")
-    b = _Builder(seed)
+    b = Builder(seed)
     rng = b.rng
     plan = _Plan(rng)
     extra_pts: list = []

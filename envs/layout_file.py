@@ -41,7 +41,7 @@ import numpy as np
 from scipy import ndimage
 
 from .geometry import Box, Cylinder
-from .layouts import WALL, WALL_H, Layout, _Builder, _segments
+from .layout_builder import WALL, WALL_H, Builder, Layout, wall_segments
 from .occupancy import layout_grid
 from .robot import ROBOT_RADIUS
 
@@ -187,7 +187,7 @@ def layout_from_dict(d: dict, source: str = "layout", base_dir: Path | None = No
     seed = d.get("texture_seed")
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, int) or seed < 0):
         r.fail("texture_seed", f"expected an integer >= 0, got {json.dumps(seed)}")
-    b = _Builder(0)
+    b = Builder(0)
     if "image" in d:
         if "walls" in d:
             r.fail("image", "give walls or an image, not both")
@@ -245,7 +245,7 @@ def _with_starts(layout: Layout, starts) -> Layout:
     return dataclasses.replace(layout, starts=tuple(tuple(float(v) for v in s) for s in starts))
 
 
-def _wall(b: _Builder, r: _Reader, w, where: str) -> None:
+def _wall(b: Builder, r: _Reader, w, where: str) -> None:
     r.keys(w, where, _WALL, ("from", "to"))
     x0, y0 = r.vector(w["from"], f"{where}.from", 2, coordinate=True)
     x1, y1 = r.vector(w["to"], f"{where}.to", 2, coordinate=True)
@@ -263,7 +263,7 @@ def _wall(b: _Builder, r: _Reader, w, where: str) -> None:
         if not a < c <= length + 1e-9:
             r.fail(f"{where}.gaps[{i}]", f"expected 0 <= start < end <= {length:g} (the wall's length), got {[a, c]}")
     ux, uy = (x1 - x0) / length, (y1 - y0) / length
-    for a, c in _segments(0.0, length, gaps):
+    for a, c in wall_segments(0.0, length, gaps):
         cx, cy = x0 + ux * (a + c) / 2, y0 + uy * (a + c) / 2
         if abs(uy) < 1e-12:
             b.box("wall", cx, cy, c - a, t, h, color)
@@ -273,7 +273,7 @@ def _wall(b: _Builder, r: _Reader, w, where: str) -> None:
             b.box("wall", cx, cy, c - a, t, h, color, yaw=math.atan2(uy, ux))
 
 
-def _furniture(b: _Builder, r: _Reader, f, where: str) -> None:
+def _furniture(b: Builder, r: _Reader, f, where: str) -> None:
     if not isinstance(f, dict) or f.get("type") not in ("box", "cylinder"):
         got = f.get("type") if isinstance(f, dict) else f
         r.fail(f"{where}.type", f"expected \"box\" or \"cylinder\", got {json.dumps(got)}")
@@ -381,7 +381,7 @@ def read_png_mask(path: Path) -> np.ndarray:
     return img < 128
 
 
-def _image_walls(b: _Builder, mask: np.ndarray, scale: float, source: str):
+def _image_walls(b: Builder, mask: np.ndarray, scale: float, source: str):
     """Dark pixels as wall boxes (runs of pixels merged into rectangles), outer walls around the image."""
     h, w = mask.shape
     check_extent((0.0, 0.0, w * scale, h * scale), source, f"{w} x {h} pixels at metres_per_pixel {scale:g}")
@@ -415,7 +415,7 @@ def layout_from_image(path, metres_per_pixel: float = DEFAULT_METRES_PER_PIXEL, 
     if not (isinstance(metres_per_pixel, int | float) and metres_per_pixel > 0 and math.isfinite(metres_per_pixel)):
         raise LayoutFileError(f"{path}: metres_per_pixel must be a positive number, got {metres_per_pixel!r}")
     path = Path(path)
-    b = _Builder(0)
+    b = Builder(0)
     bounds = _image_walls(b, read_png_mask(path), float(metres_per_pixel), str(path))
     layout = Layout(name or path.stem, tuple(float(v) for v in bounds), tuple(b.shapes), (), None, None)
     if not check_space:

@@ -8,177 +8,12 @@ are chosen so that the free area reachable from the first start (see
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
-from .geometry import Box, Cylinder, Shape
-
-WALL = 0.15
-WALL_H = 2.0
-OPENING = 1.6  # width of doorless openings between rooms: a 1 m lattice with 30-degree
-# headings passes a 0.32 m corridor half-width through them off-centre
-Pose = tuple[float, float, float]
-
-
-@dataclass(frozen=True)
-class Layout:
-    """A room description independent of any physics engine.
-
-    Attributes
-    ----------
-    name : str
-        Layout name (also seeds the textures, see ``texture_name``).
-    bounds : tuple of float
-        ``(xmin, ymin, xmax, ymax)`` of the floor, metres, world frame.
-    shapes : tuple of Shape
-        Walls and furniture (``Box`` and ``Cylinder``), each with a unique name.
-    starts : tuple of (float, float, float)
-        Start poses ``(x, y, yaw)`` in metres and radians; seed ``k`` of a study starts at
-        ``starts[k]`` while there are enough (``cogmap.starts.seed_start``).
-    paper_area : float or None
-        The free area (m2) the paper reports for this space, when it is one of the paper's.
-    texture_seed : int or None
-        Seeds the textures together with the name; None: the name alone.
-    """
-
-    name: str
-    bounds: tuple[float, float, float, float]
-    shapes: tuple[Shape, ...]
-    starts: tuple[Pose, ...]
-    paper_area: float | None = None
-    texture_seed: int | None = None  # None: textures follow the name alone
-
-    @property
-    def texture_name(self) -> str:
-        """What seeds the textures (see `textures`): the name, and the texture seed when given."""
-        return self.name if self.texture_seed is None else f"{self.name}#{self.texture_seed}"
-
-    def shape(self, name: str) -> Shape:
-        """The shape called ``name``.
-
-        Parameters
-        ----------
-        name : str
-            A shape's name.
-
-        Returns
-        -------
-        Shape
-            That shape.
-
-        Raises
-        ------
-        KeyError
-            When the layout has no shape of that name.
-        """
-        for s in self.shapes:
-            if s.name == name:
-                return s
-        raise KeyError(f"layout {self.name!r} has no shape named {name!r}")
-
-    @property
-    def names(self) -> list[str]:
-        """Names of the shapes, in order."""
-        return [s.name for s in self.shapes]
-
-    def with_moved(self, name: str, xy, yaw: float | None = None) -> Layout:
-        """A copy with shape ``name`` moved to ``xy`` (and turned to ``yaw`` for boxes).
-
-        Parameters
-        ----------
-        name : str
-            The shape to move.
-        xy : array_like
-            New centre ``(x, y)``, metres.
-        yaw : float, optional
-            New heading of a box, radians (ignored for cylinders).
-
-        Returns
-        -------
-        Layout
-            The moved copy (this layout is unchanged).
-        """
-        old = self.shape(name)
-        kw = {"x": float(xy[0]), "y": float(xy[1])}
-        if yaw is not None and isinstance(old, Box):
-            kw["yaw"] = float(yaw)
-        new = dataclasses.replace(old, **kw)
-        return dataclasses.replace(
-            self, shapes=tuple(new if s.name == name else s for s in self.shapes))
-
-
-class _Builder:
-    """Collects shapes with unique names."""
-
-    def __init__(self, seed: int):
-        self.rng = np.random.default_rng(seed)
-        self.shapes: list[Shape] = []
-        self.counts: dict[str, int] = {}
-
-    def _name(self, kind: str) -> str:
-        k = self.counts.get(kind, 0)
-        self.counts[kind] = k + 1
-        return f"{kind}_{k:02d}"
-
-    def box(self, kind, x, y, sx, sy, h=1.0, color=(0.6, 0.6, 0.6), yaw=0.0, movable=False,
-            name=None):
-        b = Box(name or self._name(kind), float(x), float(y), float(sx), float(sy), float(h),
-                float(yaw), tuple(float(c) for c in color), movable)
-        self.shapes.append(b)
-        return b
-
-    def cyl(self, kind, x, y, r, h=1.0, color=(0.5, 0.5, 0.5), movable=False, name=None):
-        c = Cylinder(name or self._name(kind), float(x), float(y), float(r), float(h),
-                     tuple(float(v) for v in color), movable)
-        self.shapes.append(c)
-        return c
-
-    def hwall(self, y, x0, x1, gaps=(), t=WALL, color=(0.8, 0.8, 0.75)):
-        """Horizontal wall along y from x0 to x1, leaving doorless openings (a, b)."""
-        for a, b in _segments(x0, x1, gaps):
-            self.box("wall", (a + b) / 2, y, b - a, t, WALL_H, color)
-
-    def vwall(self, x, y0, y1, gaps=(), t=WALL, color=(0.8, 0.8, 0.75)):
-        """Vertical wall along x from y0 to y1, leaving doorless openings (a, b)."""
-        for a, b in _segments(y0, y1, gaps):
-            self.box("wall", x, (a + b) / 2, t, b - a, WALL_H, color)
-
-    def enclosure(self, w, h, colors):
-        """Outer walls around the interior [0, w] x [0, h]; one colour per side (S, E, N, W)."""
-        t = WALL
-        self.box("wall", w / 2, -t / 2, w + 2 * t, t, WALL_H, colors[0])
-        self.box("wall", w + t / 2, h / 2, t, h, WALL_H, colors[1])
-        self.box("wall", w / 2, h + t / 2, w + 2 * t, t, WALL_H, colors[2])
-        self.box("wall", -t / 2, h / 2, t, h, WALL_H, colors[3])
-        return (-t, -t, w + t, h + t)
-
-    def names(self):
-        return [s.name for s in self.shapes]
-
-    def jitter(self, s):
-        return float(self.rng.uniform(-s, s))
-
-    def color(self):
-        return tuple(float(v) for v in self.rng.uniform(0.15, 0.95, 3))
-
-    def layout(self, name, bounds, starts, paper_area=None) -> Layout:
-        return Layout(name, tuple(float(b) for b in bounds), tuple(self.shapes),
-                      tuple(tuple(float(v) for v in s) for s in starts), paper_area)
-
-
-def _segments(a0, a1, gaps):
-    segs, cur = [], a0
-    for g0, g1 in sorted(gaps):
-        if g0 > cur:
-            segs.append((cur, g0))
-        cur = max(cur, g1)
-    if a1 > cur:
-        segs.append((cur, a1))
-    return segs
-
+# the room record and wall constants live in .layout_builder; importable from here as before
+from .layout_builder import OPENING, WALL, WALL_H, Builder, Layout, Pose, wall_segments  # noqa: F401
 
 SIDE_COLORS = ((0.85, 0.3, 0.25), (0.25, 0.55, 0.85), (0.3, 0.75, 0.35), (0.9, 0.8, 0.3))
 RACK = (0.2, 0.35, 0.75)
@@ -186,7 +21,7 @@ PALLET = (0.75, 0.55, 0.3)
 FORKLIFT = (0.95, 0.7, 0.1)
 
 
-def _forklift(b: _Builder, x, y, yaw):
+def _forklift(b: Builder, x, y, yaw):
     """Body box, two thin forks and two mast legs (hard for a planar LiDAR)."""
     c, s = np.cos(yaw), np.sin(yaw)
     b.box("forklift", x, y, 1.4, 0.9, 1.2, FORKLIFT, yaw)
@@ -198,7 +33,7 @@ def _forklift(b: _Builder, x, y, yaw):
 
 def mini_warehouse(seed: int = 0) -> Layout:
     """About 36 m2: an open room with a movable central box and a few pallets."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 6.6, 6.0
     bounds = b.enclosure(w, h, SIDE_COLORS)
     b.box("box", w / 2, h / 2, 1.2, 1.2, 1.0, (0.85, 0.45, 0.1), movable=True,
@@ -212,7 +47,7 @@ def mini_warehouse(seed: int = 0) -> Layout:
 
 def small_warehouse(seed: int = 0) -> Layout:
     """About 80 m2: two rack rows and some pallets and barrels."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 10.4, 8.8
     bounds = b.enclosure(w, h, SIDE_COLORS)
     for y in (3.0, 5.8):
@@ -227,7 +62,7 @@ def small_warehouse(seed: int = 0) -> Layout:
 
 def large_warehouse(seed: int = 0) -> Layout:
     """About 280 m2: four long rack rows forming aisles, forklifts and pallets."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 22.0, 16.2
     bounds = b.enclosure(w, h, SIDE_COLORS)
     rack_colors = [(0.2, 0.35, 0.75), (0.75, 0.2, 0.3), (0.2, 0.6, 0.55), (0.55, 0.3, 0.7)]
@@ -248,7 +83,7 @@ def large_warehouse(seed: int = 0) -> Layout:
 
 def house(seed: int = 0) -> Layout:
     """About 175 m2: kitchen, living room, playroom, three bedrooms, a hallway; no doors."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 17.0, 12.3
     bounds = b.enclosure(w, h, [(0.85, 0.85, 0.8)] * 4)
     t = 0.12
@@ -301,7 +136,7 @@ def house(seed: int = 0) -> Layout:
 
 def bedroom(seed: int = 0) -> Layout:
     """About 20 m2: bed, nightstands, wardrobe, desk and chair."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 5.45, 4.9
     bounds = b.enclosure(w, h, [(0.9, 0.85, 0.7), (0.7, 0.8, 0.9), (0.9, 0.85, 0.7),
                                 (0.8, 0.7, 0.85)])
@@ -321,7 +156,7 @@ CAR_COLORS = [(0.8, 0.1, 0.1), (0.1, 0.2, 0.7), (0.9, 0.9, 0.9), (0.15, 0.15, 0.
 
 def parking_lot(seed: int = 0, n_cars: int = 12) -> Layout:
     """About 325 m2: two rows of parking slots along the long walls; cars are movable."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 26.0, 16.6
     bounds = b.enclosure(w, h, [(0.6, 0.6, 0.6), (0.7, 0.55, 0.45), (0.6, 0.6, 0.6),
                                 (0.45, 0.55, 0.7)])
@@ -341,7 +176,7 @@ def parking_lot(seed: int = 0, n_cars: int = 12) -> Layout:
 
 def aisle_warehouse(seed: int = 0) -> Layout:
     """About 185 m2: three rack rows forming two long aisles, and an open area."""
-    b = _Builder(seed)
+    b = Builder(seed)
     w, h = 19.2, 12.0
     bounds = b.enclosure(w, h, SIDE_COLORS)
     # rows at x 1.6-13.6 and y 1.6-2.6, 4.9-5.9, 8.2-9.2: aisles, side strips and the
@@ -361,7 +196,7 @@ def aisle_warehouse(seed: int = 0) -> Layout:
 def random_rooms(seed: int = 0, n_x: int = 3, n_y: int = 2, size=(3.0, 6.0),
                  door: float = OPENING, furniture: int = 2) -> Layout:
     """A grid of rooms with random sizes, doorless openings forming a connected plan."""
-    b = _Builder(seed)
+    b = Builder(seed)
     rng = b.rng
     xs = np.concatenate([[0.0], np.cumsum(rng.uniform(*size, n_x))])
     ys = np.concatenate([[0.0], np.cumsum(rng.uniform(*size, n_y))])

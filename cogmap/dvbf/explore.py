@@ -613,7 +613,7 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
     from cogmap.envs.maze_traversal import traverse
     from cogmap.genmodel.dvbf import DVBFConfig
 
-    from .run import load_params, save_params
+    from .model_files import load_params, save_params
     from .slam import pretrain_emission
 
     cache = None

@@ -2,7 +2,7 @@
 (local processes or Ray), resumable, with the paper's numbers beside ours."""
 
 from .registry import get_study, register_study, run_specs, studies, study_plan, unregister_study
-from .runner import main, run_study
+from .runner import run_study
 
-__all__ = ["get_study", "main", "register_study", "run_specs", "run_study", "studies", "study_plan",
+__all__ = ["get_study", "register_study", "run_specs", "run_study", "studies", "study_plan",
            "unregister_study"]

@@ -1,5 +1,8 @@
+"""``python -m cogmap.study ARGS`` is ``cogmap reproduce ARGS`` (one-line errors, ``--debug``)."""
+
 import sys
 
-from .runner import main
+from cogmap.cli import main
 
-sys.exit(main())
+if __name__ == "__main__":
+    sys.exit(main(["reproduce", *sys.argv[1:]]))

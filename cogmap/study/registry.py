@@ -77,7 +77,20 @@ def register_study(name: str, *, plan, specs, run, report, overwrite: bool = Fal
 
 
 def unregister_study(name: str) -> None:
-    """Remove a study added with :func:`register_study` (built-in ones stay)."""
+    """Remove a study added with :func:`register_study` (built-in ones stay).
+
+    Parameters
+    ----------
+    name : str
+        The registered name.
+
+    Raises
+    ------
+    ValueError
+        For a built-in study.
+    KeyError
+        If no study has that name.
+    """
     if name in _BUILTIN:
         raise ValueError(f"unregister_study: '{name}' is a built-in study")
     if name not in _STUDIES:
@@ -86,12 +99,26 @@ def unregister_study(name: str) -> None:
 
 
 def studies() -> tuple[str, ...]:
-    """Names of the registered studies, in registration order."""
+    """Names of the registered studies, in registration order.
+
+    Returns
+    -------
+    tuple of str
+    """
     return tuple(_STUDIES)
 
 
 def get_study(name: str) -> StudyEntry:
     """The study registered under ``name``.
+
+    Parameters
+    ----------
+    name : str
+        A registered name (:func:`studies`).
+
+    Returns
+    -------
+    StudyEntry
 
     Raises
     ------
@@ -107,6 +134,20 @@ def get_study(name: str) -> StudyEntry:
 def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
     """Environments, methods, seeds and parameters of ``study`` at ``scale``.
 
+    Parameters
+    ----------
+    study : str
+        A registered study.
+    scale : str, optional
+        ``"reduced"`` (default), ``"full"`` or ``"tiny"``.
+    envs, seeds, methods : sequence, optional
+        Restrict the study's environments, seeds and methods.
+
+    Returns
+    -------
+    dict
+        The plan: ``study``, ``scale``, ``envs``, ``methods``, ``seeds``, ``steps``, ``params``, ...
+
     Raises
     ------
     ValueError
@@ -120,7 +161,18 @@ def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, method
 
 def run_specs(plan: dict) -> list[dict]:
     """One JSON-able spec per run of ``plan`` (each with its key: readable names plus a digest of
-    everything that changes the run, so a changed setting never reuses an old run)."""
+    everything that changes the run, so a changed setting never reuses an old run).
+
+    Parameters
+    ----------
+    plan : dict
+        From :func:`study_plan`.
+
+    Returns
+    -------
+    list of dict
+        One spec per run, each with its ``key``.
+    """
     return get_study(plan["study"]).specs(plan)
 
 

@@ -261,25 +261,3 @@ def run_from_args(args) -> int:
     if summary["duplicates"]:
         return 4
     return 0 if summary["complete"] else 3
-
-
-def main(argv=None) -> int:
-    """Command-line entry point: ``python -m cogmap.study ARGS`` is ``cogmap reproduce ARGS``.
-
-    Parameters
-    ----------
-    argv : list of str, optional
-        Arguments after the program name; default ``sys.argv[1:]``.
-
-    Returns
-    -------
-    int
-        Exit status.
-    """
-    from cogmap.cli import main as cli_main  # one-line errors, --debug
-
-    return cli_main(["reproduce", *(sys.argv[1:] if argv is None else argv)])
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())

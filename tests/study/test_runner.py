@@ -4,7 +4,8 @@ import json
 
 import pytest
 
-from cogmap.study import main, run_study
+from cogmap.cli import main as cli_main
+from cogmap.study import run_study
 from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import load_runs
 from cogmap.study.runs import strip_timings
@@ -120,7 +121,7 @@ def test_resumed_study_gives_the_same_table_as_an_uninterrupted_one(tmp_path):
 
 
 def test_cli_entry_point(tmp_path, capsys):
-    code = main(["goals", "--scale", "tiny", "--seeds", "0", "--out", str(tmp_path), "--quiet"])
+    code = cli_main(["reproduce", "goals", "--scale", "tiny", "--seeds", "0", "--out", str(tmp_path), "--quiet"])
     assert code == 0
     out = capsys.readouterr().out
     assert "Executed vs. A*" in out
