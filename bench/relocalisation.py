@@ -31,7 +31,7 @@ import numpy as np
 from cogmap.agent.encoder import SSIMEncoder, ssim
 from cogmap.agent.sensing import scan_points
 from cogmap.envs import NavSim, OdometryNoise, SimConfig, make_layout
-from cogmap.envs.robot import wrap
+from cogmap.genmodel.numerics import wrap_angle
 from cogmap.inference.se2 import about, apply, icp
 from cogmap.study.config import DRIFT_LEVELS
 
@@ -96,7 +96,7 @@ def main(argv=None) -> None:
         panos, true, odom, scans = wander(args.env, OdometryNoise(**params), args.steps, args.step, args.seed)
         width = panos[0].shape[1]
         col = 2 * np.pi / width
-        err = wrap(odom[:, 2] - true[:, 2])  # heading error of the odometry at each step
+        err = wrap_angle(odom[:, 2] - true[:, 2])  # heading error of the odometry at each step
         enc = SSIMEncoder(shortlist=None)
         for im in panos:
             enc.add(im)
@@ -108,7 +108,7 @@ def main(argv=None) -> None:
             raw, found, oracle, tshift, serr, inl, perr = [], [], [], [], [], [], []
             for i, j in zip(ii, jj, strict=True):
                 # roll(pano_j, s) lines up with pano_i when s = (err_j - err_i) / column
-                s_true = int(np.round(wrap(err[j] - err[i]) / col))
+                s_true = int(np.round(wrap_angle(err[j] - err[i]) / col))
                 raw.append(ssim(panos[j], panos[i]))
                 _, s, score = enc.align(panos[j], [i], args.max_shift)
                 found.append(score)
@@ -116,7 +116,7 @@ def main(argv=None) -> None:
                 tshift.append(abs(s_true))
                 serr.append(abs((s - s_true + width // 2) % width - width // 2))
                 # C takes the points seen at j (odometry frame j) onto those seen at i
-                c_true = about(wrap(err[i] - err[j]), odom[j, :2],
+                c_true = about(wrap_angle(err[i] - err[j]), odom[j, :2],
                                odom[i, :2] + np_rot(err[i]) @ (true[j, :2] - true[i, :2]))
                 init = about(-s * col, odom[j, :2], odom[j, :2])
                 a = icp(odom[j, :2] + scans[j], odom[i, :2] + scans[i], init, max_distance=1.5)

@@ -13,6 +13,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cogmap.genmodel.numerics import wrap_angle
+
 from .maze import Maze
 
 N_BEAMS = 20
@@ -20,11 +22,6 @@ LIDAR_RANGE = 0.53
 AGENT_RADIUS = 1e-5
 WALL_HEIGHT = 0.1
 RAY_Z = 0.05
-
-
-def wrap_angle(a):
-    """Angle(s) wrapped to ``[-pi, pi)``."""
-    return (np.asarray(a, float) + np.pi) % (2 * np.pi) - np.pi
 
 
 @dataclass(frozen=True)

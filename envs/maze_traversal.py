@@ -15,8 +15,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cogmap.genmodel.numerics import wrap_angle
+
 from .maze import Maze
-from .maze_sim import ActuationNoise, MazeSim, wrap_angle
+from .maze_sim import ActuationNoise, MazeSim
 
 
 @dataclass(frozen=True)

@@ -6,6 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cogmap.genmodel.numerics import wrap_angle
+
 from .geometry import ShapeSet
 
 ROBOT_RADIUS = 0.22  # TurtleBot3 Waffle footprint (about 0.28 x 0.31 m) enclosed in a disc
@@ -17,11 +19,6 @@ MAX_SLIP = 0.5
 MAX_HEADING_BIAS = 0.5
 #: largest ``trans_std`` (m per sqrt m) and ``rot_std`` (rad per sqrt m) of :class:`OdometryNoise`
 MAX_ODOMETRY_STD = 1.0
-
-
-def wrap(a):
-    """Wrap angles to [-pi, pi)."""
-    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
 @dataclass
@@ -123,7 +120,7 @@ class Odometry:
 
     def rotate(self, dtheta: float) -> None:
         """In-place rotation, measured exactly (gyro-aided)."""
-        self.pose[2] = float(wrap(self.pose[2] + dtheta))
+        self.pose[2] = float(wrap_angle(self.pose[2] + dtheta))
 
     def translate(self, dist: float) -> None:
         """Forward motion of true length `dist` along the current heading."""
@@ -135,7 +132,7 @@ class Odometry:
         mid = self.pose[2] + dyaw / 2
         self.pose[0] += d * np.cos(mid)
         self.pose[1] += d * np.sin(mid)
-        self.pose[2] = float(wrap(self.pose[2] + dyaw))
+        self.pose[2] = float(wrap_angle(self.pose[2] + dyaw))
         self.travelled += dist
 
 

@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cogmap.genmodel.numerics import wrap_angle
+
 from .geometry import ShapeSet
 from .layouts import Layout, make_layout
 from .occupancy import OccupancyGrid, layout_grid
@@ -24,7 +26,6 @@ from .robot import (
     OdometryNoise,
     odom_to_world,
     straight_move,
-    wrap,
 )
 from .sensors import FaultSchedule, lidar_angles, obstacle_signal
 
@@ -294,7 +295,7 @@ class NavSim:
         blocked_by = None
         if req > 1e-9:
             heading = float(np.arctan2(delta[1], delta[0]))
-            self.odom.rotate(float(wrap(heading - self.pose[2])))
+            self.odom.rotate(float(wrap_angle(heading - self.pose[2])))
             self.pose[2] = heading
             end, dist, ok, hit = straight_move(self.shapes, self.config.robot_radius,
                                                start[:2], target, self.config.move_increment)

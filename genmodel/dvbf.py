@@ -26,6 +26,7 @@ import numpy as np
 
 from .charts import chart
 from .latent_map import MAP_DIM
+from .numerics import wrap_angle
 
 LOG_2PI = float(np.log(2 * np.pi))
 #: bounds on the sizes of a DVBF-LM model (checked by :class:`DVBFConfig` before any array is
@@ -165,27 +166,23 @@ def log_likelihood_marginal(emission: Emission, q_map, poses: jax.Array, scan: j
     return -0.5 * jnp.sum(r2 + jnp.log(total), -1) - 0.5 * scan.shape[-1] * LOG_2PI
 
 
-def wrap(a: jax.Array) -> jax.Array:
-    return (a + jnp.pi) % (2 * jnp.pi) - jnp.pi
-
-
 def kinematic_mean(z: jax.Array, u: jax.Array) -> jax.Array:
     """Engineered transition mean for poses ``(..., 3)`` and controls ``(..., 2) = (d_phi, d_p)``:
     rotate first, then move ``d_p`` along the new heading (Appendix A-A)."""
     phi = z[..., 2] + u[..., 0]
-    return jnp.stack([z[..., 0] + u[..., 1] * jnp.cos(phi), z[..., 1] + u[..., 1] * jnp.sin(phi), wrap(phi)], -1)
+    return jnp.stack([z[..., 0] + u[..., 1] * jnp.cos(phi), z[..., 1] + u[..., 1] * jnp.sin(phi), wrap_angle(phi)], -1)
 
 
 def transition_sample(key: jax.Array, z: jax.Array, u: jax.Array, sigma_t) -> jax.Array:
     """Sample ``z' ~ N(kinematic_mean(z, u), diag(sigma_t^2))`` for poses ``(K, 3)``."""
     noise = jnp.asarray(sigma_t) * jax.random.normal(key, z.shape)
     out = kinematic_mean(z, u) + noise
-    return out.at[..., 2].set(wrap(out[..., 2]))
+    return out.at[..., 2].set(wrap_angle(out[..., 2]))
 
 
 def transition_log_prob(z_next: jax.Array, z: jax.Array, u: jax.Array, sigma_t) -> jax.Array:
     """``log p(z' | z, u)`` of the engineered transition (heading residual wrapped)."""
     s = jnp.asarray(sigma_t)
     d = z_next - kinematic_mean(z, u)
-    d = d.at[..., 2].set(wrap(d[..., 2]))
+    d = d.at[..., 2].set(wrap_angle(d[..., 2]))
     return -0.5 * jnp.sum((d / s) ** 2, -1) - jnp.sum(jnp.log(s)) - 1.5 * LOG_2PI

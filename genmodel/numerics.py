@@ -58,3 +58,24 @@ def normalise(x: np.ndarray, axis: int = 0) -> np.ndarray:
     s = x.sum(axis=axis, keepdims=True)
     n = x.shape[axis]
     return np.where(s > 0, x / np.where(s > 0, s, 1.0), 1.0 / n)
+
+
+def wrap_angle(a):
+    """Angles wrapped to ``[-pi, pi)``: ``(a + pi) mod 2 pi - pi``, elementwise.
+
+    The one angle wrap of the toolkit: numpy arrays, scalars and sequences (as float arrays) and
+    jax arrays (traced too, returned as jax arrays) alike.
+
+    Parameters
+    ----------
+    a : float, array_like or jax.Array
+        Angles in radians.
+
+    Returns
+    -------
+    numpy.ndarray or jax.Array
+        The wrapped angles, same shape (a 0-d array for a number).
+    """
+    if type(a).__module__.split(".")[0] not in ("jax", "jaxlib"):
+        a = np.asarray(a, dtype=float)
+    return (a + np.pi) % (2 * np.pi) - np.pi

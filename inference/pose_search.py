@@ -119,7 +119,8 @@ def _refiner(cfg, iters: int, lr: float):
     import jax.numpy as jnp
     import optax
 
-    from cogmap.genmodel.dvbf import predict_scan, wrap
+    from cogmap.genmodel.dvbf import predict_scan
+    from cogmap.genmodel.numerics import wrap_angle
 
     opt = optax.adam(lr)
 
@@ -135,7 +136,7 @@ def _refiner(cfg, iters: int, lr: float):
                 g = jax.grad(nll)(z)
                 upd, s = opt.update(g, s, z)
                 z = optax.apply_updates(z, upd)
-                z = jnp.stack([jnp.clip(z[0], 0.0, cfg.extent), jnp.clip(z[1], 0.0, cfg.extent), wrap(z[2])])
+                z = jnp.stack([jnp.clip(z[0], 0.0, cfg.extent), jnp.clip(z[1], 0.0, cfg.extent), wrap_angle(z[2])])
                 return (z, s), None
 
             (z, _), _ = jax.lax.scan(body, (z0, opt.init(z0)), None, length=iters)

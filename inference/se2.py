@@ -11,10 +11,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-
-def wrap_angle(a):
-    """Angles wrapped to [-pi, pi)."""
-    return (np.asarray(a, dtype=float) + np.pi) % (2 * np.pi) - np.pi
+from cogmap.genmodel.numerics import wrap_angle
 
 
 def rotation(yaw: float) -> np.ndarray:

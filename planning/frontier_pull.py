@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from cogmap.genmodel.numerics import wrap_angle
+
 
 def _cells(xy, extent: float, side: int) -> np.ndarray:
     """Integer ``(i, j)`` cells (``i`` along x) of world points ``xy (..., 2)``, clipped to the grid."""
@@ -321,7 +323,7 @@ def pursue(path_xy, pose, steps: int, max_turn: float, max_step: float, lookahea
         else:
             err = np.arctan2(ty - y, tx - x) - h
             bound = first_turn if t == 0 else max_turn
-            turn = float(np.clip((err + np.pi) % (2 * np.pi) - np.pi, -bound, bound))
+            turn = float(np.clip(wrap_angle(err), -bound, bound))
         h += turn
         x, y = x + max_step * np.cos(h), y + max_step * np.sin(h)
         out[t] = turn, max_step

@@ -39,12 +39,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from cogmap.genmodel.numerics import wrap_angle
+
 ScanFn = Callable[[np.ndarray], np.ndarray]
-
-
-def wrap_angle(a):
-    """Angle(s) wrapped to ``[-pi, pi)``."""
-    return (np.asarray(a, float) + np.pi) % (2 * np.pi) - np.pi
 
 
 @dataclass(frozen=True)

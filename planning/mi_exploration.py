@@ -41,7 +41,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from cogmap.genmodel.charts import bilinear_read
-from cogmap.genmodel.dvbf import DVBFConfig, kinematic_mean, predict_scan, wrap
+from cogmap.genmodel.dvbf import DVBFConfig, kinematic_mean, predict_scan
+from cogmap.genmodel.numerics import wrap_angle
 
 from .knn_entropy import mutual_information
 
@@ -162,7 +163,7 @@ def rollout(start, controls, noise=None, sigma_t=None):
         z = kinematic_mean(z, u)
         if sigma_t is not None:
             z = z + jnp.asarray(sigma_t) * e
-            z = z.at[2].set(wrap(z[2]))
+            z = z.at[2].set(wrap_angle(z[2]))
         return z, z
 
     eps = jnp.zeros((controls.shape[0], 3)) if noise is None else noise

@@ -12,6 +12,7 @@ import networkx as nx
 import numpy as np
 
 from cogmap.genmodel import SparseTransitions
+from cogmap.genmodel.numerics import wrap_angle
 
 from .arrays import PlanningArrays
 
@@ -21,7 +22,7 @@ STAY = 12
 
 def heading_index(dx: float, dy: float) -> int:
     ang = np.arctan2(dy, dx) % (2 * np.pi)
-    diff = np.abs((HEADINGS - ang + np.pi) % (2 * np.pi) - np.pi)
+    diff = np.abs(wrap_angle(HEADINGS - ang))
     return int(np.argmin(diff))
 
 

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseA, SparseB, compile
+from cogmap.genmodel.numerics import wrap_angle
 from cogmap.inference import bayes_filter
 from cogmap.inference.learning import Event, learn_observation, learn_transition
 from cogmap.inference.se2 import SE2, apply, apply_pose, compose, invert, rotate
@@ -702,7 +703,7 @@ class AIMAPPAgent:
         sector = np.pi / cfg.num_headings
         out = np.full(cfg.num_headings, -1)
         for h in range(cfg.num_headings):
-            off = np.abs((bearing - 2 * np.pi * h / cfg.num_headings + np.pi) % (2 * np.pi) - np.pi)
+            off = np.abs(wrap_angle(bearing - 2 * np.pi * h / cfg.num_headings))
             ok = off <= sector + 1e-9
             if ok.any():
                 out[h] = int(idx[ok][np.argmin(dist[ok])])  # ties: the lowest index, as before

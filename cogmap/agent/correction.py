@@ -53,7 +53,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from cogmap.inference.se2 import SE2, about, apply, icp, wrap_angle
+from cogmap.genmodel.numerics import wrap_angle
+from cogmap.inference.se2 import SE2, about, apply, icp
 
 from .encoder import best_shift
 

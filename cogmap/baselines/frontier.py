@@ -472,19 +472,3 @@ class FrontierExplorer(BaselinePolicy):
         if wp is None:
             return None
         return wp, "odom"
-
-    def believed_pose(self, sim) -> np.ndarray:
-        """The robot's believed position: its odometry.
-
-        Parameters
-        ----------
-        sim : NavSim
-            The simulator.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(2,)`` float, metres (nan while odometry is dropped).
-        """
-        odom = sim.odometry()
-        return np.full(2, np.nan) if odom is None else odom[:2]

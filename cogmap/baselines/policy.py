@@ -64,8 +64,9 @@ class BaselinePolicy:
         """
         raise NotImplementedError
 
-    def believed_pose(self, sim) -> np.ndarray:  # pragma: no cover - abstract
-        """Where the baseline believes the robot is (implemented by each baseline).
+    def believed_pose(self, sim) -> np.ndarray:
+        """Where the baseline believes the robot is: its odometry position (the oracle overrides
+        this with the true pose).
 
         Parameters
         ----------
@@ -75,9 +76,10 @@ class BaselinePolicy:
         Returns
         -------
         numpy.ndarray
-            ``(2,)`` float ``(x, y)``, metres.
+            ``(2,)`` float, metres (nan while odometry is dropped).
         """
-        raise NotImplementedError
+        odom = sim.odometry()
+        return np.full(2, np.nan) if odom is None else odom[:2]
 
     def step(self, sensed: SimView) -> Command:
         """Plan and wrap the result as a harness command with the trajectory row.

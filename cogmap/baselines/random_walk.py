@@ -48,19 +48,3 @@ class RandomWalk(BaselinePolicy):
         if odom is None:  # no odometry: move blind relative to the true pose cannot be commanded
             return sim.true_pose()[:2], "world"
         return odom[:2] + self.step_length * np.array([np.cos(h), np.sin(h)]), "odom"
-
-    def believed_pose(self, sim) -> np.ndarray:
-        """The odometry position.
-
-        Parameters
-        ----------
-        sim : NavSim
-            The simulator.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(2,)`` float, metres (nan while odometry is dropped).
-        """
-        odom = sim.odometry()
-        return np.full(2, np.nan) if odom is None else odom[:2]

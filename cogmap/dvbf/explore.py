@@ -59,7 +59,8 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from cogmap.envs.maze import Maze, exploration_ratio
-from cogmap.envs.maze_sim import ActuationNoise, MazeSim, wrap_angle
+from cogmap.envs.maze_sim import ActuationNoise, MazeSim
+from cogmap.genmodel.numerics import wrap_angle
 from cogmap.planning.mi_exploration import MIConfig
 
 METHODS = ("mi", "random", "frontier")

@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from cogmap.envs.maze import Maze, make_maze
+from cogmap.genmodel.numerics import wrap_angle
 from cogmap.planning.hybrid_astar import HybridAStarConfig, Plan, cost_grid, plan_path
 
 SUCCESS_RADIUS = 0.05  # Section V-B b
@@ -265,7 +266,7 @@ def _row(pair, which, plan: Plan, executed, blocked, goal) -> dict:
     walked = float(np.sum(np.hypot(*np.diff(executed[:, :2], axis=0).T))) if len(executed) > 1 else 0.0
     return {"start": pair[0], "goal": pair[1], "model": which, "found": plan.found,
             "success": bool(plan.found and err <= SUCCESS_RADIUS), "final_error": err,
-            "heading_error": float(abs((final[2] - goal[2] + np.pi) % (2 * np.pi) - np.pi)),
+            "heading_error": float(abs(wrap_angle(final[2] - goal[2]))),
             "plan_length": plan.length if plan.found else None, "executed_length": walked,
             "blocked_moves": blocked, "controls": len(plan.controls), "expansions": plan.expansions,
             "queries": plan.queries, "plan_s": plan.seconds, "reason": plan.reason}

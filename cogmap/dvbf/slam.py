@@ -21,6 +21,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from cogmap.genmodel.dvbf import DVBFConfig
+from cogmap.genmodel.numerics import wrap_angle
 
 
 @dataclass(frozen=True)
@@ -143,7 +144,7 @@ def path_integration(start, controls) -> np.ndarray:
     for u in np.asarray(controls, float):
         x, y, a = poses[-1]
         a = a + u[0]
-        poses.append(np.array([x + u[1] * np.cos(a), y + u[1] * np.sin(a), (a + np.pi) % (2 * np.pi) - np.pi]))
+        poses.append(np.array([x + u[1] * np.cos(a), y + u[1] * np.sin(a), wrap_angle(a)]))
     return np.array(poses)
 
 

@@ -8,7 +8,8 @@ import pytest
 
 from cogmap.agent.correction import panorama_columns, to_frame_panorama
 from cogmap.agent.encoder import best_shift, column_shift_scores, ssim
-from cogmap.inference.se2 import SE2, about, apply, apply_pose, compose, fit, icp, invert, wrap_angle
+from cogmap.genmodel.numerics import wrap_angle
+from cogmap.inference.se2 import SE2, about, apply, apply_pose, compose, fit, icp, invert
 
 
 def random_transforms(rng, n):

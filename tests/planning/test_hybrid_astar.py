@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from cogmap.genmodel.numerics import wrap_angle
 from cogmap.planning.hybrid_astar import (
     HybridAStarConfig,
     SafetyTerm,
@@ -12,7 +13,6 @@ from cogmap.planning.hybrid_astar import (
     holonomic_cost_to_go,
     plan_path,
     rollout,
-    wrap_angle,
 )
 
 N_BEAMS, RANGE = 20, 0.53
