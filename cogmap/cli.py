@@ -66,7 +66,7 @@ def _explore(args) -> int:
 
     out = Path(args.out)
     noise = OdometryNoise(slip=args.slip, heading_bias=args.heading_bias)
-    config = replace(default_config(args.env), encoder=args.encoder)
+    config = replace(default_config(args.env), encoder=args.encoder, scheme=args.scheme)
     metrics = explore(args.env, steps=args.steps, seed=args.seed, out=out, progress=not args.quiet,
                       patience=args.patience, noise=noise, config=config, checkpoint_every=args.checkpoint_every,
                       resume=args.resume)
@@ -79,9 +79,13 @@ def _explore_check(args) -> None:
     """The environment exists before anything starts (a layout file is read, every entry checked and
     bounded); the checks that rasterise a building run in the run itself, under --time-limit."""
     if not args.resume:
+        from . import inference
         from .explore import check_env
 
         check_env(args.env)
+        if args.scheme not in inference.available():
+            raise ValueError(f"unknown inference scheme {args.scheme!r} (--scheme); registered: "
+                             f"{', '.join(inference.available())}")
 
 
 def _goal(args) -> int:
@@ -199,6 +203,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="odometry drift: yaw error in rad per metre travelled, in [-0.5, 0.5] (default: 0)")
     e.add_argument("--encoder", default="ssim", help="observation encoder by name (default: ssim, the paper's; "
                    "others from --plugin modules)")
+    e.add_argument("--scheme", default="filter",
+                   help="inference scheme that localises the agent: filter (default, the paper's exact filter), "
+                   "exact, fpi, vmp, mmp, or one registered by a --plugin module")
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.add_argument("--checkpoint-every", type=decisions, default=10, metavar="N",

@@ -6,8 +6,10 @@ Each :meth:`AIMAPPAgent.step` runs sense -> infer -> learn -> plan and returns w
    grows A_o); the believed pose is the odometry pose mapped by ``frame``, the rigid transform
    (yaw + translation) of the last re-localisation; panorama, LiDAR returns and obstacle flags
    are turned into that belief frame (``_to_belief``), and waypoints back to odometry.
-2. *infer* (``_infer``): the single-factor filter combines the B_s prediction of the last move
-   with A_o and A_p evidence; the confidence test scores the result (``confidence.py``).
+2. *infer* (``_infer``): the inference scheme named by ``AgentConfig.scheme`` (the paper's
+   single-factor Bayes filter by default; any registered scheme that accepts the model) combines
+   the B_s prediction of the last move with A_o and A_p evidence; the confidence test scores the
+   result (``confidence.py``).
 3. *learn* (``_update``): when confident, A_o ties the observation to the believed state, a
    recognised place corrects the pose drift (``correction.py``: panorama shift for the heading,
    LiDAR alignment with the place's anchor for the position), the executed or failed move updates B_s
@@ -32,9 +34,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from cogmap import inference
 from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseA, SparseB, compile
 from cogmap.genmodel.numerics import wrap_angle
-from cogmap.inference import bayes_filter
 from cogmap.inference.learning import Event, learn_observation, learn_transition
 from cogmap.inference.se2 import SE2, apply, apply_pose, compose, invert, rotate
 
@@ -224,6 +226,9 @@ class AIMAPPAgent:
         self.cfg = config or AgentConfig()
         self.encoder: Encoder = encoder if encoder is not None else make_encoder(self.cfg.encoder, self.cfg)
         check_encoder(self.encoder)
+        inference.get(self.cfg.scheme)  # an unknown scheme: a KeyError naming the registered ones
+        if model is not None:
+            self._check_scheme(model)
         self.rng = np.random.default_rng(seed)
         self.model = model
         self.q: np.ndarray | None = None
@@ -408,7 +413,7 @@ class AIMAPPAgent:
             return self._paused(sensed)  # nothing places the agent (or a first view is incomplete)
         pose = self.believed_pose(sensed.odometry)
         if self.model is None:
-            self.model = initial_model(self.cfg, pose)
+            self.model = self._check_scheme(initial_model(self.cfg, pose))
             self.q = np.ones(1)
         local = self._to_belief(sensed)
         obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
@@ -502,6 +507,12 @@ class AIMAPPAgent:
         self.corrections += 1
         return True
 
+    def _check_scheme(self, model: Model) -> Model:
+        if not inference.accepts(self.cfg.scheme, model):
+            raise ValueError(f"AgentConfig.scheme: inference scheme '{self.cfg.scheme}' does not accept AIMAPP's "
+                             f"model; schemes that do: {', '.join(inference.accepting(model))}")
+        return model
+
     def _observe(self, panorama) -> tuple[int, float]:
         """Observation id (a new id grows A_o) and the encoder's best similarity score."""
         obs, _ = self.encoder(panorama)
@@ -516,12 +527,13 @@ class AIMAPPAgent:
         """Posterior over states and the confidence test (section 3.3, A.1.2); ``obs`` is None
         while the camera is silent (the pose evidence alone then localises)."""
         cfg = self.cfg
+        scheme = inference.get(cfg.scheme)  # the paper's exact filter by default (AgentConfig.scheme)
         if self.lost:  # re-localising: odometry is not trusted, only what is seen
             prior = self._visited_prior()
-            q = [prior] if obs is None else bayes_filter(self.model, [prior], [{"view": obs}])[0]
+            q = [prior] if obs is None else scheme(self.model, [prior], [{"view": obs}])[0]
         else:  # B_s prediction combined with A_o and A_p evidence
             prior = self._prior(self._outcome)
-            q, _ = bayes_filter(self.model, [prior], [{"view": obs, "pose": pose}])
+            q, _ = scheme(self.model, [prior], [{"view": obs, "pose": pose}])
         q = q[0]
         d2 = np.sum((self.poses - pose) ** 2, axis=1)
         near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are

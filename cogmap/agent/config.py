@@ -50,6 +50,12 @@ class AgentConfig:
     encoder : str
         Name of the observation encoder (see :func:`cogmap.agent.encoder.register_encoder`);
         ``"ssim"``, the paper's, by default.
+    scheme : str
+        The registered inference scheme that localises the agent at each step (its belief over
+        places from ``B_s``'s prediction, ``A_o`` and ``A_p``), any that accepts AIMAPP's one-factor
+        sparse model (:func:`cogmap.inference.accepting`: ``"exact"``, ``"filter"``, ``"fpi"``,
+        ``"vmp"``, ``"mmp"`` or one of yours); ``"filter"``, the exact Bayes filter of the paper, by
+        default.
     mcts_depth : int
         Steps of the MCTS lookahead (Appendix A.3 and Table 6: 10).
     mcts_simulations : int
@@ -190,6 +196,7 @@ class AgentConfig:
     passage_width: float = 2.5  # predicted states in narrower corridors go to the centre line (0: off)
     ssim_threshold: float = 0.65  # place recognition (Table 6)
     encoder: str = "ssim"  # observation encoder by name (cogmap.agent.encoder.register_encoder)
+    scheme: str = "filter"  # inference scheme by name (cogmap.inference.register); the paper's: filter
     mcts_depth: int = 10  # Appendix A.3
     mcts_simulations: int = 30
     mcts_count_information_once: bool = False  # Eq. 5 sums every step's EFE (see MCTSConfig)
@@ -269,13 +276,16 @@ class AgentConfig:
         Returns
         -------
         dict
-            Field name -> value; ``encoder`` is left out when it is the default ``"ssim"`` and
+            Field name -> value; ``encoder`` is left out when it is the default ``"ssim"``,
+            ``scheme`` when it is ``"filter"`` and
             ``view_bounds`` when None (so manifests and study run keys made before these fields
             existed stay the same; :meth:`from_dict` restores them).
         """
         d = asdict(self)
         if d["view_bounds"] is None:  # likewise: runs that know no outline keep their keys
             del d["view_bounds"]
+        if d["scheme"] == "filter":  # the paper's scheme is implicit too: earlier run keys stay valid
+            del d["scheme"]
         if d["encoder"] == "ssim":
             # the paper's encoder is left implicit (from_dict restores it), so the manifests and
             # study run keys of runs made before encoders were chosen by name stay the same
@@ -357,6 +367,8 @@ def _check_values(cfg) -> None:
         elif kind == "str":
             if not isinstance(v, str):
                 bad(name, v, "a string")
+            if name in ("scheme", "encoder") and not v:
+                bad(name, v, "a non-empty string")
 
 
 def _check_keys(cls, d: dict) -> None:
