@@ -150,3 +150,11 @@ def test_no_private_name_is_imported_from_another_module():
                 bad += [f"{mod}: {node.module} {a.name}" for a in node.names
                         if a.name.startswith("_") and not a.name.startswith("__")]
     assert bad == []
+
+
+def test_inference_planning_and_envs_import_only_genmodel_of_each_other():
+    graph = import_graph()
+    libs = ("cogmap.inference", "cogmap.planning", "cogmap.envs")
+    bad = sorted(f"{m} -> {t}" for m, targets in graph.items() for t in targets for lib in libs
+                 if m.startswith(lib) and any(t.startswith(o) for o in libs if o != lib))
+    assert bad == []
