@@ -27,8 +27,8 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from typing import Any, NamedTuple
 
-from cogmap.genmodel.contracts import Agent, check_conforms
-from cogmap.genmodel.registry import check_name
+from cogmap.genmodel.contracts import Agent
+from cogmap.genmodel.registry import Registry
 
 
 class AgentEntry(NamedTuple):
@@ -60,8 +60,7 @@ class DroneObservation(NamedTuple):
     contact: Any = None
 
 
-_AGENTS: dict[str, AgentEntry] = {}
-_BUILTIN: set[str] = set()
+_AGENTS = Registry("agent", "register_agent", protocol=Agent)
 
 
 def register_agent(name: str, *, init, step, overwrite: bool = False) -> AgentEntry:
@@ -89,48 +88,15 @@ def register_agent(name: str, *, init, step, overwrite: bool = False) -> AgentEn
     TypeError
         ``init`` or ``step`` not callable as the contract says.
     """
-    check_name("register_agent", name)
-    entry = AgentEntry(name, init, step)
-    check_conforms("register_agent", "agent", name, entry, Agent)
-    if name in _BUILTIN:
-        raise ValueError(f"register_agent: '{name}' is a built-in agent; choose another name")
-    if name in _AGENTS and not overwrite:
-        raise ValueError(f"register_agent: an agent named '{name}' exists (pass overwrite=True)")
-    _AGENTS[name] = entry
-    return entry
+    return _AGENTS.add(name, AgentEntry(name, init, step), overwrite)
 
 
-def get_agent(name: str) -> AgentEntry:
-    """The agent registered under ``name``.
-
-    Parameters
-    ----------
-    name : str
-        A registered name (:func:`agents`).
-
-    Returns
-    -------
-    AgentEntry
-
-    Raises
-    ------
-    KeyError
-        For an unknown name (the message lists the agents).
-    """
-    try:
-        return _AGENTS[name]
-    except KeyError:
-        raise KeyError(f"unknown agent '{name}' (available: {agents()})") from None
-
-
-def agents() -> tuple[str, ...]:
-    """Names of the registered agents.
-
-    Returns
-    -------
-    tuple of str
-    """
-    return tuple(_AGENTS)
+#: the agent registered under a name (``KeyError`` listing the agents for an unknown one)
+get_agent = _AGENTS.get
+#: names of the registered agents
+agents = _AGENTS.names
+#: remove an agent added with :func:`register_agent`
+unregister_agent = _AGENTS.remove
 
 
 # -- the built-in agents ------------------------------------------------------------------------------
@@ -179,4 +145,4 @@ def _drone_step(agent, observation: DroneObservation):
 for _name, _init, _step in (("loop", _loop_init, _loop_step), ("aimapp", _aimapp_init, _aimapp_step),
                             ("drone", _drone_init, _drone_step)):
     register_agent(_name, init=_init, step=_step)
-_BUILTIN.update(_AGENTS)
+_AGENTS.seal()

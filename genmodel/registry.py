@@ -75,3 +75,115 @@ def check_entry(func: str, kind: str, name: str, obj, table: Mapping, builtin: C
         raise ValueError(f"{func}: '{name}' is a built-in {kind}; choose another name")
     if name in table and not overwrite and not again:
         raise ValueError(f"{func}: a {kind} named '{name}' exists (pass overwrite=True)")
+
+
+class Registry:
+    """Named entries of one kind, each checked against its contract when added; the names present
+    when :meth:`seal` is called are built in (they can be neither replaced nor removed).
+
+    Parameters
+    ----------
+    kind : str
+        What is registered (``"agent"``, ``"study"``), for the messages.
+    func : str
+        The registering function's name, for the messages (``"register_agent"``).
+    protocol : type, optional
+        The contract of :mod:`cogmap.genmodel.contracts` every entry must meet.
+    missing : type, optional
+        The exception :meth:`get` raises for an unknown name, default ``KeyError``.
+    """
+
+    def __init__(self, kind: str, func: str, protocol=None, missing: type[Exception] = KeyError):
+        self.kind, self.func, self.protocol, self.missing = kind, func, protocol, missing
+        self._entries: dict = {}
+        self._builtin: frozenset[str] = frozenset()
+
+    def add(self, name: str, entry, overwrite: bool = False):
+        """Register ``entry`` under ``name`` and return it.
+
+        Parameters
+        ----------
+        name : str
+            Non-empty name.
+        entry : object
+            What is registered.
+        overwrite : bool, optional
+            Replace an entry registered earlier under ``name`` (built-in ones cannot be replaced).
+
+        Returns
+        -------
+        object
+            ``entry``.
+
+        Raises
+        ------
+        ValueError
+            Empty name, a built-in name, or a taken name without ``overwrite``.
+        TypeError
+            ``entry`` does not meet the contract.
+        """
+        check_name(self.func, name)
+        if self.protocol is not None:
+            check_conforms(self.func, self.kind, name, entry, self.protocol)
+        if name in self._builtin:
+            raise ValueError(f"{self.func}: '{name}' is a built-in {self.kind}; choose another name")
+        if name in self._entries and not overwrite:
+            raise ValueError(f"{self.func}: a {self.kind} named '{name}' exists (pass overwrite=True)")
+        self._entries[name] = entry
+        return entry
+
+    def remove(self, name: str) -> None:
+        """Remove the entry registered under ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A name added after :meth:`seal`.
+
+        Raises
+        ------
+        ValueError
+            For a built-in name.
+        KeyError
+            If nothing has that name.
+        """
+        if name in self._builtin:
+            raise ValueError(f"'{name}' is a built-in {self.kind} and cannot be removed")
+        if name not in self._entries:
+            raise KeyError(f"no {self.kind} named '{name}'")
+        del self._entries[name]
+
+    def get(self, name: str):
+        """The entry registered under ``name``.
+
+        Parameters
+        ----------
+        name : str
+            A registered name.
+
+        Returns
+        -------
+        object
+
+        Raises
+        ------
+        Exception
+            ``missing`` (``KeyError`` by default) for an unknown name, listing the registered ones.
+        """
+        try:
+            return self._entries[name]
+        except (KeyError, TypeError):
+            raise self.missing(f"unknown {self.kind} {name!r}; choose from {self.names()}") from None
+
+    def names(self) -> tuple[str, ...]:
+        """The registered names, in registration order.
+
+        Returns
+        -------
+        tuple of str
+        """
+        return tuple(self._entries)
+
+    def seal(self) -> None:
+        """Make every name registered so far a built-in one."""
+        self._builtin = frozenset(self._entries)

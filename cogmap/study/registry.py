@@ -20,8 +20,8 @@ from functools import partial
 from pathlib import Path
 from typing import NamedTuple
 
-from cogmap.genmodel.contracts import Study, check_conforms
-from cogmap.genmodel.registry import check_name
+from cogmap.genmodel.contracts import Study
+from cogmap.genmodel.registry import Registry
 
 from . import config, drone, dvbf_exploration, dvbf_navigation, dvbf_slam, report, runs
 
@@ -38,8 +38,7 @@ class StudyEntry(NamedTuple):
     report: Callable[..., str]
 
 
-_STUDIES: dict[str, StudyEntry] = {}
-_BUILTIN: set[str] = set()
+_STUDIES = Registry("study", "register_study", protocol=Study, missing=ValueError)
 
 
 def register_study(name: str, *, plan, specs, run, report, overwrite: bool = False) -> StudyEntry:
@@ -65,70 +64,15 @@ def register_study(name: str, *, plan, specs, run, report, overwrite: bool = Fal
     TypeError
         A function missing or not callable as the contract says.
     """
-    check_name("register_study", name)
-    entry = StudyEntry(name, plan, specs, run, report)
-    check_conforms("register_study", "study", name, entry, Study)
-    if name in _BUILTIN:
-        raise ValueError(f"register_study: '{name}' is a built-in study; choose another name")
-    if name in _STUDIES and not overwrite:
-        raise ValueError(f"register_study: a study named '{name}' exists (pass overwrite=True)")
-    _STUDIES[name] = entry
-    return entry
+    return _STUDIES.add(name, StudyEntry(name, plan, specs, run, report), overwrite)
 
 
-def unregister_study(name: str) -> None:
-    """Remove a study added with :func:`register_study` (built-in ones stay).
-
-    Parameters
-    ----------
-    name : str
-        The registered name.
-
-    Raises
-    ------
-    ValueError
-        For a built-in study.
-    KeyError
-        If no study has that name.
-    """
-    if name in _BUILTIN:
-        raise ValueError(f"unregister_study: '{name}' is a built-in study")
-    if name not in _STUDIES:
-        raise KeyError(f"no study named '{name}'")
-    del _STUDIES[name]
-
-
-def studies() -> tuple[str, ...]:
-    """Names of the registered studies, in registration order.
-
-    Returns
-    -------
-    tuple of str
-    """
-    return tuple(_STUDIES)
-
-
-def get_study(name: str) -> StudyEntry:
-    """The study registered under ``name``.
-
-    Parameters
-    ----------
-    name : str
-        A registered name (:func:`studies`).
-
-    Returns
-    -------
-    StudyEntry
-
-    Raises
-    ------
-    ValueError
-        For an unknown name (the message lists the studies).
-    """
-    try:
-        return _STUDIES[name]
-    except (KeyError, TypeError):
-        raise ValueError(f"unknown study {name!r}; choose from {studies()}") from None
+#: the study registered under a name (``ValueError`` listing the studies for an unknown one)
+get_study = _STUDIES.get
+#: names of the registered studies, in registration order
+studies = _STUDIES.names
+#: remove a study added with :func:`register_study` (built-in ones stay)
+unregister_study = _STUDIES.remove
 
 
 def study_plan(study: str, scale: str = "reduced", envs=None, seeds=None, methods=None) -> dict:
@@ -239,4 +183,4 @@ register_study("dvbf-exploration", plan=dvbf_exploration.dvbf_exploration_plan,
                report=dvbf_exploration.dvbf_exploration_report)
 register_study("dvbf-slam", plan=dvbf_slam.dvbf_slam_plan, specs=dvbf_slam.dvbf_slam_specs,
                run=dvbf_slam.run_dvbf_slam, report=dvbf_slam.dvbf_slam_report)
-_BUILTIN.update(_STUDIES)
+_STUDIES.seal()
