@@ -59,12 +59,13 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from cogmap.envs.maze import Maze, exploration_ratio
-from cogmap.envs.maze_sim import ActuationNoise, MazeSim
+from cogmap.envs.maze_sim import MazeSim
 from cogmap.genmodel.numerics import wrap_angle
 from cogmap.planning.mi_exploration import MIConfig
 
+from .maze_model import NOISE, maze_model
+
 METHODS = ("mi", "random", "frontier")
-NOISE = ActuationNoise(rot_std=0.005, trans_frac=0.05)
 
 
 @dataclass(frozen=True)
@@ -612,7 +613,6 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
 
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_traversal import traverse
-    from cogmap.genmodel.dvbf import DVBFConfig
 
     from .model_files import load_params, save_params
     from .slam import pretrain_emission
@@ -624,7 +624,7 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
             return load_params(cache)[0].emission
     maze = make_maze(0)
     tr = traverse(maze, steps, seed=seed + 1000, noise=NOISE)
-    model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64, sigma_t=(0.0005, 0.0005, NOISE.rot_std))
+    model = maze_model(maze)
     emission, _ = pretrain_emission(tr.poses, tr.scans, model, iters=iters, seed=seed)
     if cache is not None:
         import tempfile
@@ -682,13 +682,11 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         slam = planner = None
         use_slam = cfg.method == "mi" or cfg.learn_map
         if use_slam:
-            from cogmap.genmodel.dvbf import DVBFConfig
             from cogmap.genmodel.latent_map import kl_map
 
             from .slam import OnlineSLAM, SLAMConfig
 
-            model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64,
-                               sigma_t=(0.0005, 0.0005, NOISE.rot_std))
+            model = maze_model(maze)
             sc = SLAMConfig(model=model, seed=cfg.seed, train_every=cfg.train_every, train_iters=cfg.train_iters,
                             freeze_emission=emission is not None)
             slam = OnlineSLAM(pose, sc, steps + cfg.train_every, emission=emission, first_scan=scan)

@@ -18,12 +18,10 @@ import numpy as np
 from cogmap.envs.maze import make_maze
 from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
-from cogmap.genmodel.dvbf import DVBFConfig
 
+from .maze_model import NOISE, maze_model
 from .model_files import MAX_MODEL_JSON_BYTES, DVBFModelError, load_params, save_params  # noqa: F401  (importable from here)
 from .slam import SLAMConfig, online_slam, path_integration, pretrain_emission
-
-NOISE = ActuationNoise(rot_std=0.005, trans_frac=0.05)
 
 
 def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium",
@@ -113,8 +111,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     maze, tr = slam_traversal(maze_seed, steps, seed, complexity, corridor, noise)
-    model = DVBFConfig(extent=maze.size, map_side=maze.map_side, hidden=64,
-                       sigma_t=(0.0005, 0.0005, noise.rot_std))
+    model = maze_model(maze, noise)
     emission = None
     if pretrain_maze is not None:
         first = traverse(make_maze(pretrain_maze, complexity, corridor), pretrain_steps, seed=seed + 1000, noise=noise)

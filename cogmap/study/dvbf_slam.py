@@ -67,8 +67,8 @@ def _maze_seed(env: str) -> int:
 
 
 def dvbf_slam_specs(plan: dict) -> list[dict]:
+    from cogmap.dvbf.maze_model import NOISE
     from cogmap.dvbf.offline import OfflineConfig
-    from cogmap.dvbf.run import NOISE
     from cogmap.dvbf.slam import SLAMConfig
     from cogmap.inference.grid_mcl import MCLConfig
 

@@ -53,7 +53,7 @@ def test_bad_input_is_refused():
 
 
 def test_mcl_on_the_true_map_beats_path_integration_on_a_traversal():
-    from cogmap.dvbf.run import NOISE
+    from cogmap.dvbf.maze_model import NOISE
     from cogmap.dvbf.slam import path_integration
 
     maze = make_maze(2)
