@@ -35,7 +35,7 @@ from .efe import (
     state_preference,
     unregister_term,
 )
-from .mcts import Decision, MCTSConfig, mcts, ucb_select
+from .mcts import MCTSConfig, SearchResult, mcts, ucb_select
 from .planners import (
     Plan,
     PlanSettings,
@@ -53,7 +53,7 @@ from .policies import (
 )
 
 __all__ = [
-    "Decision",
+    "SearchResult",
     "DenseStep",
     "LocalStep",
     "MCTSConfig",

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import efe
 from .arrays import PlanningArrays, from_model, prepare
-from .mcts import Decision, MCTSConfig, mcts
+from .mcts import MCTSConfig, SearchResult, mcts
 from .threads import limited
 
 MODES = {"explore": efe.exploration, "goal": efe.goal, "full": efe.full, "sensed": efe.sensed_exploration,
@@ -56,7 +56,7 @@ def decide(
     view=None,
     config: MCTSConfig | None = None,
     rng: np.random.Generator | int | None = None,
-) -> Decision:
+) -> SearchResult:
     """Choose the next control by MCTS over EFE.
 
     Parameters
@@ -83,7 +83,7 @@ def decide(
 
     Returns
     -------
-    Decision
+    SearchResult
     """
     if isinstance(model, PlanningArrays):
         arrays = model

@@ -157,8 +157,8 @@ def ucb_select(n: np.ndarray, w: np.ndarray, g: np.ndarray, N: int, c: float, ti
 
 
 @dataclass
-class Decision:
-    """The outcome of one MCTS decision.
+class SearchResult:
+    """The outcome of one tree search: the chosen control and the statistics of the root candidates.
 
     Attributes
     ----------
@@ -289,7 +289,7 @@ class BeliefExpander:
         return hit
 
 
-def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> Decision:
+def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> SearchResult:
     """Run ``cfg.simulations`` simulations of ``cfg.depth`` steps and decide."""
     acts, g, g_known, kids = expander.root()
     root = Node(acts, g, kids, rng.random(len(g)) * 1e-9, g_known)
@@ -333,7 +333,7 @@ def search(expander, cfg: MCTSConfig, rng: np.random.Generator) -> Decision:
     i = int(rng.choice(len(probs), p=probs)) if cfg.sample else int(np.argmax(probs))
     a = root.actions[i]
     action = int(a) if np.ndim(a) == 0 else tuple(int(x) for x in a)
-    return Decision(
+    return SearchResult(
         action=action,
         actions=root.actions,
         probs=probs,
@@ -351,7 +351,7 @@ def mcts(
     obstacles=None,
     config: MCTSConfig | None = None,
     rng: np.random.Generator | int | None = None,
-) -> Decision:
+) -> SearchResult:
     """MCTS decision from a belief: a tree over states (one sparse factor) or over full beliefs.
 
     Parameters
@@ -371,7 +371,7 @@ def mcts(
 
     Returns
     -------
-    Decision
+    SearchResult
 
     Notes
     -----
