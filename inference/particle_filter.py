@@ -73,15 +73,20 @@ def weighted_moments(state: ParticleState) -> tuple[jax.Array, jax.Array]:
 
 
 def pf_run(key: jax.Array, state: ParticleState, controls: jax.Array, observations: jax.Array,
-           transition: Callable, log_likelihood: Callable):
-    """Filter ``observations (T, ...)`` after ``controls (T, ...)`` (control t leads to observation t).
+           transition: Callable, log_likelihood: Callable, record: Callable | None = None):
+    """Filter ``observations (T, ...)`` after ``controls (T, ...)`` (control t leads to observation t)
+    in one ``lax.scan``; step t uses the t-th key of ``jax.random.split(key, T)``.
 
-    Returns the final state and per-step ``(mean (T, D), std (T, D), log_z (T,))``.
+    Returns the final state and per-step ``(mean (T, D), std (T, D), log_z (T,))``, or, with
+    ``record(key_t, state_t) -> pytree``, what ``record`` returns at each step, stacked (the online
+    SLAM keeps a sample of the particles and their moments this way).
     """
 
     def body(s, inp):
         k, u, x = inp
         s, log_z = pf_step(k, s, u, x, transition, log_likelihood)
+        if record is not None:
+            return s, record(k, s)
         mean, std = weighted_moments(s)
         return s, (mean, std, log_z)
 

@@ -234,7 +234,7 @@ def _compiled(config: SLAMConfig, capacity: int):
 
     from cogmap.genmodel.dvbf import log_likelihood, log_likelihood_marginal, transition_sample
     from cogmap.inference.elbo import make_optimizer, make_train_step
-    from cogmap.inference.particle_filter import pf_step, weighted_moments
+    from cogmap.inference.particle_filter import pf_run, weighted_moments
 
     cfg = config.model
     opt = make_optimizer(config.learning_rate)
@@ -253,15 +253,13 @@ def _compiled(config: SLAMConfig, capacity: int):
         def trans(k, z, ctrl):
             return transition_sample(k, z, ctrl, sigma_t)
 
-        def body(s, inp):
-            k, u, x = inp
-            s, _ = pf_step(k, s, u, x, trans, lik)
+        def record(k, s):  # a sample of the filtered particles (for training) and their moments
             idx = jax.random.choice(jax.random.fold_in(k, 7), s.particles.shape[0], (config.cache,),
                                     p=jnp.exp(s.log_weights))
             mean, std = weighted_moments(s)
-            return s, (s.particles[idx], mean, std)
+            return s.particles[idx], mean, std
 
-        return jax.lax.scan(body, state, (jax.random.split(key, us.shape[0]), us, xs))
+        return pf_run(key, state, us, xs, trans, lik, record=record)
 
     return opt, train_step, filter_chunk
 
