@@ -130,11 +130,12 @@ def test_the_pull_leads_a_robot_out_of_what_it_has_sensed_in_a_pybullet_maze():
     import dataclasses
     from types import SimpleNamespace
 
-    from cogmap.dvbf.explore import STUDY_MI, MIPlanner
+    from cogmap.dvbf.explore import STUDY_MI
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_sim import MazeSim
     from cogmap.envs.maze_traversal import traverse
     from cogmap.genmodel.dvbf import DVBFConfig
+    from cogmap.planning.mi_planner import MIPlanner
 
     maze = make_maze(2, "moderate", "small")
     tr = traverse(maze, 300, seed=3)
