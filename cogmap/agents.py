@@ -32,7 +32,17 @@ from cogmap.genmodel.registry import Registry
 
 
 class AgentEntry(NamedTuple):
-    """A registered agent: ``init(model, config, key) -> state``, ``step(state, observation) -> (state, info)``."""
+    """A registered agent.
+
+    Attributes
+    ----------
+    name : str
+        Its registered name.
+    init : callable
+        ``init(model, config, key) -> state``.
+    step : callable
+        ``step(state, observation) -> (state, info)``.
+    """
 
     name: str
     init: Callable[[Any, Any, int], Any]

@@ -79,7 +79,7 @@ class MIPlanner:
         Parameters
         ----------
         slam : OnlineSLAM
-            Current filter and map state (read only; :class:`cogmap.dvbf.slam.OnlineSLAM` or
+            Current filter and map state (read only; :class:`cogmap.inference.online_slam.OnlineSLAM` or
             anything with its ``t``, ``estimates``, ``estimate``, ``scans``, ``particles`` and ``params``).
         rng : numpy.random.Generator
             Draws the poses of the obstacle histogram.

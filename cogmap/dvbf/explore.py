@@ -1,7 +1,7 @@
 """Exploration of a LiDAR maze with DVBF-LM (paper Section VI, Algorithm 1) and two baselines.
 
 * ``mi``: the DVBF-LM agent (``mi-pull``: the same with the frontier pull below). It learns the map
-  online while it moves (:class:`~cogmap.dvbf.slam.OnlineSLAM`,
+  online while it moves (:class:`~cogmap.inference.online_slam.OnlineSLAM`,
   20 particles, ELBO steps after every ``train_every`` steps; emission pretrained on a first maze and
   frozen, as in ``cogmap dvbf slam``). Every ``replan_every`` steps it builds the obstacle penalty from
   its own map, generates candidate control sequences, scores them by ``I(x_1:T; M)``
@@ -448,9 +448,9 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
 
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_traversal import traverse
+    from cogmap.inference.online_slam import pretrain_emission
 
     from .model_files import load_params, save_params
-    from .slam import pretrain_emission
 
     cache = None
     if cache_dir is not None:
@@ -518,8 +518,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         use_slam = cfg.method == "mi" or cfg.learn_map
         if use_slam:
             from cogmap.genmodel.latent_map import kl_map
-
-            from .slam import OnlineSLAM, SLAMConfig
+            from cogmap.inference.online_slam import OnlineSLAM, SLAMConfig
 
             model = maze_model(maze)
             sc = SLAMConfig(model=model, seed=cfg.seed, train_every=cfg.train_every, train_iters=cfg.train_iters,

@@ -208,9 +208,9 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     """
     from cogmap.envs.maze_traversal import traverse
     from cogmap.genmodel.dvbf import DVBFConfig
+    from cogmap.inference.online_slam import fit_known_poses
 
     from .maze_model import NOISE
-    from .slam import fit_known_poses
 
     if pretrain_maze is not None and pretrain_maze == maze.seed:
         raise ValueError(f"learn_model: the emission is pretrained on maze {pretrain_maze}; learn another maze")

@@ -18,10 +18,10 @@ import numpy as np
 from cogmap.envs.maze import make_maze
 from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
+from cogmap.inference.online_slam import SLAMConfig, online_slam, path_integration, pretrain_emission
 
 from .maze_model import NOISE, maze_model
 from .model_files import MAX_MODEL_JSON_BYTES, DVBFModelError, load_params, save_params  # noqa: F401  (importable from here)
-from .slam import SLAMConfig, online_slam, path_integration, pretrain_emission
 
 
 def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium",
@@ -57,7 +57,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
              complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
              pretrain_steps: int = 2000, pretrain_iters: int = 1500, offline: bool = False,
              noise: ActuationNoise = NOISE, **overrides) -> dict:
-    """Run online SLAM (or, with ``offline``, offline SLAM: :mod:`cogmap.dvbf.offline`) on maze
+    """Run online SLAM (or, with ``offline``, offline SLAM: :mod:`cogmap.inference.offline_slam`) on maze
     ``maze_seed`` for ``steps`` steps and write the run directory to ``out``.
 
     With ``pretrain_maze`` (default 0), the emission network is first trained with known poses on a
@@ -85,11 +85,11 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     pretrain_iters : int
         ELBO steps of the pretraining.
     offline : bool
-        Optimise all steps at once (:func:`~cogmap.dvbf.offline.offline_slam`) instead of the online sweep.
+        Optimise all steps at once (:func:`~cogmap.inference.offline_slam.offline_slam`) instead of the online sweep.
     noise : ActuationNoise
         Actuation noise of both traversals; the motion model's heading noise follows its ``rot_std``.
     **overrides
-        :class:`SLAMConfig` fields, or :class:`~cogmap.dvbf.offline.OfflineConfig` fields with ``offline``.
+        :class:`SLAMConfig` fields, or :class:`~cogmap.inference.offline_slam.OfflineConfig` fields with ``offline``.
 
     Returns
     -------
@@ -118,7 +118,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
         emission, _ = pretrain_emission(first.poses, first.scans, model, iters=pretrain_iters, seed=seed)
         overrides = {"freeze_emission": True, **overrides}
     if offline:
-        from .offline import OfflineConfig
+        from cogmap.inference.offline_slam import OfflineConfig
 
         config = OfflineConfig(model=model, seed=seed, **overrides)
     else:
@@ -142,7 +142,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
             last[0] = t
 
     if offline:
-        from .offline import offline_slam
+        from cogmap.inference.offline_slam import offline_slam
 
         res = offline_slam(tr.scans, tr.controls, tr.poses[0], config, progress=tick, emission=emission)
     else:

@@ -9,7 +9,7 @@ paper's 6 mazes x 4 traversals, 3,000 steps each.
 A second method, ``mcl``, stands in for Cartographer (C++/ROS, not available here): Monte Carlo
 localisation on the **true** occupancy grid (:mod:`cogmap.inference.grid_mcl`) over the same traversals,
 a privileged reference that needs no map learning. A third, ``offline``, is the paper's offline SLAM
-(:mod:`cogmap.dvbf.offline`, same pretrained emission) with the settings :data:`OFFLINE`.
+(:mod:`cogmap.inference.offline_slam`, same pretrained emission) with the settings :data:`OFFLINE`.
 """
 
 from __future__ import annotations
@@ -68,9 +68,9 @@ def _maze_seed(env: str) -> int:
 
 def dvbf_slam_specs(plan: dict) -> list[dict]:
     from cogmap.dvbf.maze_model import NOISE
-    from cogmap.dvbf.offline import OfflineConfig
-    from cogmap.dvbf.slam import SLAMConfig
     from cogmap.inference.grid_mcl import MCLConfig
+    from cogmap.inference.offline_slam import OfflineConfig
+    from cogmap.inference.online_slam import SLAMConfig
 
     from .config import spec_digest
 
@@ -131,9 +131,9 @@ def _run_mcl(spec: dict) -> dict:
     import time
 
     from cogmap.dvbf.run import slam_traversal
-    from cogmap.dvbf.slam import path_integration
     from cogmap.envs.maze_sim import LIDAR_RANGE
     from cogmap.inference.grid_mcl import MCLConfig, mcl_localise
+    from cogmap.inference.online_slam import path_integration
 
     tic = time.perf_counter()
     maze, tr = slam_traversal(_maze_seed(spec["env"]), spec["steps"], spec["seed"])

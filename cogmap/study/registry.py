@@ -29,7 +29,15 @@ SCALES = ("reduced", "full", "tiny")
 
 
 class StudyEntry(NamedTuple):
-    """A registered study (see the module docstring for the four functions)."""
+    """A registered study (see the module docstring for the four functions).
+
+    Attributes
+    ----------
+    name : str
+        Its registered name.
+    plan, specs, run, report : callable
+        The study's four functions.
+    """
 
     name: str
     plan: Callable[..., dict]

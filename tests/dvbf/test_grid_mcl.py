@@ -54,7 +54,7 @@ def test_bad_input_is_refused():
 
 def test_mcl_on_the_true_map_beats_path_integration_on_a_traversal():
     from cogmap.dvbf.maze_model import NOISE
-    from cogmap.dvbf.slam import path_integration
+    from cogmap.inference.online_slam import path_integration
 
     maze = make_maze(2)
     tr = traverse(maze, 600, seed=3, noise=NOISE)

@@ -6,12 +6,12 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from cogmap.dvbf.slam import path_integration
 from cogmap.envs.maze import make_maze
 from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
 from cogmap.genmodel.dvbf import DVBFConfig, log_likelihood_marginal, transition_sample
 from cogmap.inference.elbo import Batch, init_opt_state, init_params, make_optimizer, make_train_step
+from cogmap.inference.online_slam import path_integration
 from cogmap.inference.particle_filter import pf_init, pf_run
 
 

@@ -4,12 +4,12 @@ round schedule, and bad settings."""
 import numpy as np
 import pytest
 
-from cogmap.dvbf.offline import OfflineConfig, offline_slam
-from cogmap.dvbf.slam import path_integration, pretrain_emission
 from cogmap.envs.maze import make_maze
 from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
 from cogmap.genmodel.dvbf import DVBFConfig
+from cogmap.inference.offline_slam import OfflineConfig, offline_slam
+from cogmap.inference.online_slam import path_integration, pretrain_emission
 
 
 @pytest.mark.heavy

@@ -8,8 +8,8 @@ import pytest
 
 from cogmap.cli import build_parser
 from cogmap.dvbf.run import load_params, slam_run
-from cogmap.dvbf.slam import path_integration
 from cogmap.envs.maze_sim import ActuationNoise
+from cogmap.inference.online_slam import path_integration
 
 
 @pytest.mark.heavy

@@ -1,5 +1,5 @@
 """Offline SLAM with DVBF-LM (paper Section IV, Appendix B-I): every time step of a recorded traversal
-is optimised at once, instead of the online sweep of :mod:`cogmap.dvbf.slam`.
+is optimised at once, instead of the online sweep of :mod:`cogmap.inference.online_slam`.
 
 The pose posterior is the offline particle filter (:func:`cogmap.inference.chunked_filter.chunked_filter`:
 chunks of 5 steps in order, a categorical proposal with 0.001 jitter at each chunk start, 1,000 particles,
@@ -23,7 +23,7 @@ import numpy as np
 
 from cogmap.genmodel.dvbf import DVBFConfig
 
-from .slam import SLAMResult, path_integration
+from .online_slam import SLAMResult, path_integration
 
 
 @dataclass(frozen=True)
