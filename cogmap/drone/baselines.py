@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .agent import Decision, VoxelMap
+from .agent import Decision, DronePolicy, VoxelMap
 
 
 @dataclass
@@ -15,7 +15,7 @@ class _Plan:
     efe_us_per_candidate: float = float("nan")
 
 
-class StraightLine:
+class StraightLine(DronePolicy):
     """Fly toward the target in steps of ``step`` metres, blind to obstacles.
 
     Parameters
@@ -40,40 +40,6 @@ class StraightLine:
         """
         return {"policy": "straight", "step": self.step, "speeds": list(self.speeds)}
 
-    def reset(self, target=None, start=None) -> None:
-        """Nothing to reset (stateless).
-
-        Parameters
-        ----------
-        target : array_like, optional
-            ``(3,)`` target position, metres.
-        start : array_like, optional
-            ``(3,)`` start position, metres.
-        """
-        pass
-
-    def observe(self, scan, position=None) -> None:
-        """Ignore the scan (blind to obstacles).
-
-        Parameters
-        ----------
-        scan : object
-            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
-        position : array_like, optional
-            Where the scan was taken (unused).
-        """
-        pass
-
-    def observe_contact(self, point) -> None:
-        """Ignore a collision's touched point (the baseline perceives LiDAR returns only).
-
-        Parameters
-        ----------
-        point : array_like
-            ``(3,)`` the touched point, metres, world frame (unused).
-        """
-        pass
-
     def decide(self, position, target) -> Decision:
         """A waypoint ``step`` metres toward the target (the target itself when closer).
 
@@ -96,7 +62,7 @@ class StraightLine:
         return Decision(wp, self.speeds[1] if n < 10 else self.speeds[0], _Plan("straight"), 0.0, {})
 
 
-class PotentialField:
+class PotentialField(DronePolicy):
     """Attraction to the target plus repulsion from voxels within ``influence`` metres.
 
     Repulsion ``k_rep (1/d - 1/influence) / d^2`` along the away direction; one step of ``step``
@@ -148,28 +114,6 @@ class PotentialField:
             ``(3,)`` start position, metres.
         """
         self.voxels = VoxelMap()
-
-    def observe(self, scan, position=None) -> None:
-        """Add a LiDAR scan to the voxel memory.
-
-        Parameters
-        ----------
-        scan : object
-            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
-        position : array_like, optional
-            Where the scan was taken (unused).
-        """
-        self.voxels.add(scan.points)
-
-    def observe_contact(self, point) -> None:
-        """Ignore a collision's touched point (the baseline perceives LiDAR returns only).
-
-        Parameters
-        ----------
-        point : array_like
-            ``(3,)`` the touched point, metres, world frame (unused).
-        """
-        pass
 
     def decide(self, position, target) -> Decision:
         """One step along the summed attractive and repulsive force.
