@@ -64,6 +64,16 @@ def test_a_scheme_with_the_wrong_call_or_an_unknown_accepts_is_refused():
     assert "two_args" not in inference.available() and "bad_accepts" not in inference.available()
 
 
+def test_an_accepts_test_that_fails_on_another_kind_of_model_does_not_accept_it():
+    inference.register("one_factor_only", lambda m, p, o, a=None: None, accepts=lambda m: len(m.factors) == 1)
+    try:
+        assert "one_factor_only" in inference.accepting(corridor(np.random.default_rng(0)))
+        assert "one_factor_only" not in inference.accepting(tmaze())  # two factors
+        assert not inference.accepts("one_factor_only", _particle_model())  # no .factors: not accepted
+    finally:
+        inference.unregister("one_factor_only")
+
+
 # -- planners -----------------------------------------------------------------------------------------
 @pytest.mark.parametrize("name", available_planners())
 def test_every_planner_conforms_and_plans_a_step(name):
