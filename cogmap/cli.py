@@ -8,7 +8,6 @@ Every error ends the command with one line on stderr naming the problem and exit
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import sys
 from pathlib import Path
@@ -26,6 +25,7 @@ from .argtypes import (
     one_line,
     seed_int,
 )
+from .plugins import import_plugins
 from .runguard import add_run_options, run_command
 
 #: ``--steps`` of explore and goal, ``--patience`` and ``--checkpoint-every``
@@ -320,8 +320,7 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     prog = f"cogmap {args.command}" + (f" {args.drone_command}" if args.command == "drone" else "")
     try:
-        for module in args.plugin:
-            importlib.import_module(module)
+        import_plugins(args.plugin)
         if hasattr(args, "out_dir"):  # a run command: run directory checks and a wall-clock limit
             return run_command(args, prog, args.out_dir(args))
         return args.func(args)

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import importlib
 import io
 import json
 import shutil
@@ -155,13 +154,13 @@ def _child(spec: dict) -> dict:
     from tqdm import tqdm
 
     from .argtypes import one_line
+    from .plugins import import_plugins
 
     # a thread lock for the progress bars: tqdm's default includes a semaphore that a killed child
     # would leave registered (the resource tracker then warns at exit)
     tqdm.set_lock(threading.RLock())
     args = spec["args"]
-    for module in getattr(args, "plugin", ()):  # the user's registrations (cogmap --plugin), in this process too
-        importlib.import_module(module)
+    import_plugins(getattr(args, "plugin", ()))  # the user's registrations (cogmap --plugin), in this process too
     buf = io.StringIO()
     try:
         with contextlib.redirect_stdout(buf):

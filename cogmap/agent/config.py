@@ -310,7 +310,8 @@ class AgentConfig:
         Raises
         ------
         ValueError
-            On a key that is not a field (of the config or of the learning rates).
+            On a key that is not a field (of the config or of the learning rates), or a
+            ``scheme`` that names no registered inference scheme.
         """
         d = dict(d)
         for key in _RETIRED & set(d):  # settings of earlier versions that no longer change a run
@@ -321,6 +322,12 @@ class AgentConfig:
             lr = dict(d["learning"])
             _check_keys(LearningRates, lr)
             d["learning"] = LearningRates(**{k: tuple(v) if isinstance(v, list) else v for k, v in lr.items()})
+        if "scheme" in d:  # a name read from a file only selects among the schemes registered in this process
+            from cogmap import inference
+
+            if d["scheme"] not in inference.available():
+                raise ValueError(f"AgentConfig.scheme: {d['scheme']!r} is not a registered inference scheme "
+                                 f"(registered: {', '.join(inference.available())}; add yours with --plugin)")
         return cls(**d)
 
 

@@ -396,12 +396,14 @@ def code_digest() -> str:
     global _DIGEST
     if _DIGEST is None:
         import hashlib
-        import importlib
+
+        import cogmap
+        from cogmap import envs, genmodel, inference, planning
 
         h = hashlib.sha256()
-        for name in ("cogmap", "cogmap.genmodel", "cogmap.inference", "cogmap.planning", "cogmap.envs"):
-            root = Path(importlib.import_module(name).__file__).parent
-            files = sorted(root.glob("*.py")) if name != "cogmap" else sorted(root.rglob("*.py"))
+        for package in (cogmap, genmodel, inference, planning, envs):
+            root = Path(package.__file__).parent
+            files = sorted(root.glob("*.py")) if package is not cogmap else sorted(root.rglob("*.py"))
             for f in files:
                 h.update(str(f.relative_to(root)).encode())
                 h.update(f.read_bytes())

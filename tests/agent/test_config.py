@@ -34,6 +34,7 @@ def test_round_trip_keeps_every_field_through_json():
     base = AgentConfig()
     changed = {f.name: _other(getattr(base, f.name)) for f in fields(AgentConfig) if f.name != "learning"}
     changed["view_bounds"] = (-1.0, -2.0, 3.0, 4.0)  # an outline, not any value
+    changed["scheme"] = "fpi"  # another registered scheme (a file may name only registered ones)
     lr = LearningRates(**{f.name: _other(getattr(base.learning, f.name)) for f in fields(LearningRates)})
     cfg = AgentConfig(**changed, learning=lr)
     for f in fields(AgentConfig):  # every field really differs from its default

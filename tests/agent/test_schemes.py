@@ -65,6 +65,18 @@ def test_a_scheme_that_refuses_the_model_or_is_unknown_is_a_clear_error():
         replace(cfg, scheme="")
     assert "scheme" not in default_config("mini_warehouse").to_dict()  # the paper's: earlier run keys stay
     assert replace(cfg, scheme="fpi").to_dict()["scheme"] == "fpi"
+    from cogmap.agent.config import AgentConfig
+
+    assert AgentConfig.from_dict(replace(cfg, scheme="fpi").to_dict()).scheme == "fpi"
+    with pytest.raises(ValueError, match="'os:system' is not a registered inference scheme"):
+        AgentConfig.from_dict({**cfg.to_dict(), "scheme": "os:system"})  # a file's name picks no code
+
+
+def test_plugins_are_imported_only_by_dotted_name():
+    from cogmap.plugins import import_plugins
+
+    with pytest.raises(ValueError, match="expected a dotted module name"):
+        import_plugins(["../evil.py"])
 
 
 def test_command_line_runs_aimapp_with_fpi_and_refuses_an_unknown_scheme(tmp_path, capsys):
