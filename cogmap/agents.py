@@ -113,9 +113,9 @@ unregister_agent = _AGENTS.remove
 def _loop_init(model, config, key):
     from cogmap import loop
 
-    options = {} if config is None else dict(config._asdict() if hasattr(config, "_asdict") else config)
-    if not isinstance(options, Mapping):
+    if config is not None and not (hasattr(config, "_asdict") or isinstance(config, Mapping)):
         raise TypeError("loop agent: config must be a mapping of loop.init keywords or a LoopConfig")
+    options = {} if config is None else dict(config._asdict() if hasattr(config, "_asdict") else config)
     options.pop("seed", None)
     extra = options.pop("scheme_options", None) or {}
     return loop.init(model, seed=int(key), **options, **extra)

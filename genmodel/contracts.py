@@ -233,30 +233,22 @@ def conformance_errors(obj, protocol) -> list[str]:
     """
     errors = []
     for name, declared in _members(protocol).items():
-        if name == "__call__":
-            target = obj
-            if not callable(obj):
-                errors.append(f"is not callable (got {type(obj).__name__})")
-                continue
-        elif not hasattr(obj, name):
+        target = obj if name == "__call__" else getattr(obj, name, None)
+        if name != "__call__" and not hasattr(obj, name):
             errors.append(f"has no '{name}'")
+        elif declared is None:  # a data member: being there is enough
             continue
+        elif not callable(target):
+            errors.append(f"is not callable (got {type(obj).__name__})" if name == "__call__"
+                          else f"'{name}' is not callable")
         else:
-            target = getattr(obj, name)
-            if declared is None:
-                continue
-            if not callable(target):
-                errors.append(f"'{name}' is not callable")
-                continue
-        if declared is None:
-            continue
-        n, kws = _required(declared)
-        if any(p.kind is p.VAR_POSITIONAL for p in inspect.signature(declared).parameters.values()):
-            continue  # the contract fixes no arity for this member
-        if not _can_take(target, n, kws):
-            shown = name if name != "__call__" else "it"
-            args = ", ".join([*list(inspect.signature(declared).parameters)[1:]])
-            errors.append(f"{shown} cannot be called as ({args})")
+            params = list(inspect.signature(declared).parameters.values())[1:]  # without self
+            if any(p.kind is p.VAR_POSITIONAL for p in params):
+                continue  # the contract fixes no arity for this member
+            n, kws = _required(declared)
+            if not _can_take(target, n, kws):
+                shown = name if name != "__call__" else "it"
+                errors.append(f"{shown} cannot be called as ({', '.join(p.name for p in params)})")
     return errors
 
 
