@@ -24,140 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from cogmap.envs.maze import Maze, make_maze
+from cogmap.envs.maze_poses import GRID, execute, grid_poses, pose_pairs
+from cogmap.genmodel.dvbf_scan import scan_models
 from cogmap.genmodel.numerics import wrap_angle
+from cogmap.inference.goal_encoding import encode_goals
 from cogmap.planning.hybrid_astar import HybridAStarConfig, Plan, cost_grid, plan_path
 
 SUCCESS_RADIUS = 0.05  # Section V-B b
-GRID = 5  # 5 x 5 poses per maze
-
-
-def grid_poses(maze: Maze, k: int = GRID, seed: int = 0) -> np.ndarray:
-    """``k * k`` free poses ``(x, y, heading)``: the points of a ``k x k`` grid over the maze, each moved
-    to the centre of the maze cell it falls in (so none lies on a wall), with seeded headings.
-
-    Parameters
-    ----------
-    maze : Maze
-        The maze.
-    k : int
-        Poses per side (default :data:`GRID`).
-    seed : int
-        Seed of the headings (combined with the maze's seed).
-
-    Returns
-    -------
-    numpy.ndarray, shape (k * k, 3)
-        ``(x, y, heading)``: cell centres in maze units, headings in radians in [-pi, pi).
-
-    Raises
-    ------
-    ValueError
-        If two grid points fall in the same maze cell.
-    """
-    rng = np.random.default_rng([seed, maze.seed])
-    pts = (np.arange(k) + 0.5) / k * maze.size
-    out = []
-    for x in pts:
-        for y in pts:
-            c = maze.cell_centre(*maze.cell_of([x, y]))
-            out.append([c[0], c[1], float(rng.uniform(-np.pi, np.pi))])
-    poses = np.array(out)
-    if len({tuple(np.round(p[:2], 9)) for p in poses}) != len(poses):
-        raise ValueError(f"grid_poses: a {k} x {k} grid does not give distinct cells in a {maze.n} x {maze.n} maze")
-    return poses
-
-
-def pose_pairs(n_poses: int, pairs: int | None = None, seed: int = 0) -> list[tuple[int, int]]:
-    """All ordered pairs ``(i, j), i != j`` of ``n_poses`` poses, or a seeded subset of ``pairs`` of them.
-
-    Parameters
-    ----------
-    n_poses : int
-        Number of poses.
-    pairs : int, optional
-        Pairs wanted; None (or at least ``n_poses * (n_poses - 1)``) gives all of them.
-    seed : int
-        Seed of the subset.
-
-    Returns
-    -------
-    list of (int, int)
-        ``(start index, goal index)`` in lexicographic order.
-
-    Raises
-    ------
-    ValueError
-        If ``pairs < 1``.
-    """
-    every = [(i, j) for i in range(n_poses) for j in range(n_poses) if i != j]
-    if pairs is None or pairs >= len(every):
-        return every
-    if pairs < 1:
-        raise ValueError(f"pose_pairs: pairs must be >= 1, got {pairs}")
-    idx = np.sort(np.random.default_rng(seed).choice(len(every), size=pairs, replace=False))
-    return [every[i] for i in idx]
-
-
-STD_K = 1.0  # planning ranges: predicted mean minus this many standard deviations under q(M)
-
-
-def learned_scan_fn(params, cfg, k_std: float = STD_K):
-    """``scan_fn`` of the learned model: ranges at poses ``(K, 3)`` from the emission on the chart of
-    q(M), lowered by ``k_std`` standard deviations of the prediction under the map's uncertainty (first
-    order, :meth:`~cogmap.genmodel.dvbf.Emission.mean_and_variance`). ``k_std = 0`` is the prediction at
-    the map mean alone. With ``k_std > 0`` parts of the map the traversal never saw (q(M) still at the
-    prior) read as close, so the safety term keeps plans out of them; at the mean they can read as open
-    (maze 2: 4 of 30 plans at the mean crossed an unseen wall, none with ``k_std = 1``).
-    Batches are padded to powers of two so few shapes are ever compiled.
-
-    Parameters
-    ----------
-    params : DVBFParams
-        The learned q(M) and emission network.
-    cfg : DVBFConfig
-        Their model (extent, beams, chart radii).
-    k_std : float
-        Standard deviations subtracted from the predicted ranges (default :data:`STD_K`).
-
-    Returns
-    -------
-    callable
-        ``scan(poses)``: poses ``(K, 3)`` (or one ``(3,)``) to ranges ``numpy.ndarray (K, n_beams)``
-        in maze units.
-    """
-    import equinox as eqx
-    import jax
-    import jax.numpy as jnp
-
-    from cogmap.genmodel.charts import chart
-
-    radii = jnp.asarray(cfg.radii)
-    mean_grid = params.q_map.mean
-    var_grid = jnp.exp(2.0 * params.q_map.log_std)
-    k = float(k_std)
-
-    @eqx.filter_jit
-    def batch(emission, mean_grid, var_grid, poses):
-        def one(z):
-            m = chart(mean_grid, z, cfg.extent, cfg.n_beams, radii)
-            if k == 0.0:
-                return emission(m)
-            mu, var = emission.mean_and_variance(m, chart(var_grid, z, cfg.extent, cfg.n_beams, radii, power=2))
-            return mu - k * jnp.sqrt(var)
-
-        return jax.vmap(one)(poses)
-
-    def scan(poses):
-        poses = np.asarray(poses, np.float32).reshape(-1, 3)
-        n = len(poses)
-        size = 1 << max(4, (n - 1).bit_length())
-        pad = np.zeros((size, 3), np.float32)
-        pad[:n] = poses
-        return np.asarray(batch(params.emission, mean_grid, var_grid, jnp.asarray(pad)))[:n].astype(float)
-
-    return scan
-
-
 def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0, pretrain_maze: int | None = None,
                 pretrain_steps: int = 2000, pretrain_iters: int = 1500, hidden: int = 64, map_side: int | None = None,
                 sigma_e: float = 0.03):
@@ -232,34 +105,6 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     return params, cfg, info
 
 
-def execute(sim, start, controls) -> tuple[np.ndarray, int]:
-    """Run ``controls`` open loop from ``start`` in ``sim``; returns executed poses and blocked moves.
-
-    Parameters
-    ----------
-    sim : MazeSim
-        The simulator (reset to ``start``).
-    start : array_like, shape (3,)
-        Start pose (x, y, heading).
-    controls : array_like, shape (n, 2)
-        Controls (turn rad, forward maze units).
-
-    Returns
-    -------
-    poses : numpy.ndarray, shape (n + 1, 3)
-        The start and the pose after each control.
-    blocked : int
-        Controls during which a wall stopped the robot.
-    """
-    poses = [sim.reset(start)]
-    blocked = 0
-    for u in np.asarray(controls, float).reshape(-1, 2):
-        pose, hit = sim.step(u)
-        poses.append(pose)
-        blocked += int(hit)
-    return np.array(poses), blocked
-
-
 def _row(pair, which, plan: Plan, executed, blocked, goal) -> dict:
     final = executed[-1]
     err = float(np.hypot(*(final[:2] - goal[:2])))
@@ -285,7 +130,7 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
     maze : Maze
         The maze.
     scan_fns : dict of str to callable
-        Model name -> ``scan(poses (K, 3)) -> ranges (K, n_beams)`` (see :func:`scan_models`).
+        Model name -> ``scan(poses (K, 3)) -> ranges (K, n_beams)`` (see :func:`cogmap.genmodel.dvbf_scan.scan_models`).
     poses : numpy.ndarray, shape (n_poses, 3)
         Candidate start and goal poses.
     pairs : iterable of (int, int)
@@ -372,95 +217,6 @@ def summarise(rows: list[dict]) -> dict:
     return out
 
 
-def scan_models(params, cfg, sim, k_std: float = STD_K) -> dict:
-    """The three worlds each pair is planned in: ``learned`` (q(M), ranges lowered by ``k_std``
-    standard deviations), ``learned_mean`` (the prediction at the map mean, the paper's reading) and
-    ``true`` (the simulator's ray casts, the reference row).
-
-    Parameters
-    ----------
-    params : DVBFParams
-        The learned q(M) and emission.
-    cfg : DVBFConfig
-        Their model.
-    sim : MazeSim
-        The true simulator (its ``lidar_batch``).
-    k_std : float
-        Standard deviations for ``learned`` (default :data:`STD_K`).
-
-    Returns
-    -------
-    dict of str to callable
-        ``{"learned", "learned_mean", "true"}`` -> ``scan(poses (K, 3)) -> ranges (K, n_beams)``.
-    """
-    return {"learned": learned_scan_fn(params, cfg, k_std), "learned_mean": learned_scan_fn(params, cfg, 0.0),
-            "true": sim.lidar_batch}
-
-
-#: the pose search of pose-to-observation (:mod:`cogmap.inference.pose_search`): a table of n_xy x n_xy
-#: positions x n_heading headings scored at once, the best ``top`` refined by ``iters`` Adam steps
-ENCODER = {"n_xy": 50, "n_heading": 40, "top": 8, "iters": 100, "lr": 0.003}
-
-
-def goal_table(params, cfg, encoder: dict = ENCODER):
-    """The learned model's predicted scans on the pose grid of ``encoder`` (map mean), for :func:`encode_goals`.
-
-    Parameters
-    ----------
-    params : DVBFParams
-        The learned q(M) and emission.
-    cfg : DVBFConfig
-        Their model.
-    encoder : dict
-        ``n_xy`` and ``n_heading`` (see :data:`ENCODER`).
-
-    Returns
-    -------
-    PoseTable
-    """
-    from cogmap.inference.pose_search import build_table
-
-    return build_table(learned_scan_fn(params, cfg, 0.0), cfg.extent, encoder["n_xy"], encoder["n_heading"])
-
-
-def encode_goals(sim, poses, params, cfg, encoder: dict = ENCODER, table=None) -> dict:
-    """Pose-to-observation goals: the pose of each goal's scan (the simulator's LiDAR at ``poses``) by the
-    pose search on the learned model, and its position error against the true pose.
-
-    Parameters
-    ----------
-    sim : MazeSim
-        The simulator that takes the goal scans.
-    poses : numpy.ndarray, shape (n, 3)
-        The true goal poses.
-    params, cfg
-        The learned model.
-    encoder : dict
-        Search settings (:data:`ENCODER`).
-    table : PoseTable, optional
-        A table from :func:`goal_table` (built here if None).
-
-    Returns
-    -------
-    dict
-        ``poses`` (n, 3) found, ``errors`` (list of position errors, maze units), ``seconds`` (search
-        wall clock, without building the table).
-    """
-    from cogmap.inference.pose_search import encode, refine
-
-    table = goal_table(params, cfg, encoder) if table is None else table
-    tic = time.perf_counter()
-    obs = sim.lidar_batch(poses)
-
-    def refine_fn(o, starts):
-        return refine(params.emission, params.q_map.mean, cfg, o, starts, sigma=cfg.sigma_e,
-                      iters=encoder["iters"], lr=encoder["lr"])
-
-    found = np.array([encode(o, table, cfg.sigma_e, refine_fn, top=encoder["top"])[0] for o in obs])
-    errors = np.hypot(*(found[:, :2] - np.asarray(poses)[:, :2]).T)
-    return {"poses": found, "errors": [float(e) for e in errors], "seconds": time.perf_counter() - tic}
-
-
 def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40, seed: int = 0,
                  complexity: str = "moderate", corridor: str = "medium", model_dir: Path | None = None,
                  map_steps: int = 2000, map_iters: int = 3000, pretrain_maze: int | None = None,
@@ -502,7 +258,7 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     grid : int
         Poses per side.
     observation_goals : bool
-        Also plan pose-to-observation: to the pose :func:`encode_goals` finds for each goal's scan, in the
+        Also plan pose-to-observation: to the pose :func:`cogmap.inference.goal_encoding.encode_goals` finds for each goal's scan, in the
         ``learned`` reading (world ``observation``; success still at the true goal).
 
     Returns
@@ -514,7 +270,7 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     Raises
     ------
     ValueError
-        If the model's extent differs from the maze's side, or from :func:`grid_poses`.
+        If the model's extent differs from the maze's side, or from :func:`cogmap.envs.maze_poses.grid_poses`.
     """
     from cogmap.envs.maze_sim import MazeSim
 

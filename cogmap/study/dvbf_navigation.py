@@ -65,7 +65,8 @@ def _maze_seed(env: str) -> int:
 
 
 def nav_specs(plan: dict) -> list[dict]:
-    from cogmap.dvbf.navigate import GRID, STD_K, pose_pairs
+    from cogmap.envs.maze_poses import GRID, pose_pairs
+    from cogmap.genmodel.dvbf_scan import STD_K
     from cogmap.planning.hybrid_astar import HybridAStarConfig
 
     from .config import spec_digest
@@ -113,18 +114,12 @@ def _model(maze_seed: int, seed: int, p: dict):
 
 
 def run_navigation(spec: dict) -> dict:
-    from cogmap.dvbf.navigate import (
-        GRID,
-        encode_goals,
-        goal_table,
-        grid_poses,
-        learned_scan_fn,
-        navigate_pairs,
-        pose_pairs,
-        scan_models,
-    )
+    from cogmap.dvbf.navigate import navigate_pairs
     from cogmap.envs.maze import make_maze
+    from cogmap.envs.maze_poses import GRID, grid_poses, pose_pairs
     from cogmap.envs.maze_sim import MazeSim
+    from cogmap.genmodel.dvbf_scan import learned_scan_fn, scan_models
+    from cogmap.inference.goal_encoding import encode_goals, goal_table
     from cogmap.planning.hybrid_astar import HybridAStarConfig, SafetyTerm
 
     p = {**spec["params"], **spec["method_options"].get("model", {})}

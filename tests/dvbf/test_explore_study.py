@@ -7,9 +7,11 @@ import numpy as np
 import pytest
 
 from cogmap.cli import build_parser
-from cogmap.dvbf.explore import ExploreConfig, Frontier, explore, ratio_at, start_pose
+from cogmap.dvbf.explore import ExploreConfig, explore, ratio_at
 from cogmap.dvbf.run import explore_run
 from cogmap.envs.maze import exploration_ratio, make_maze
+from cogmap.envs.maze_poses import start_pose
+from cogmap.planning.maze_explorers import Frontier
 from cogmap.study import run_study
 from cogmap.study.registry import run_specs, study_plan
 from cogmap.study.runner import load_runs

@@ -7,18 +7,11 @@ import numpy as np
 import pytest
 
 from cogmap.cli import build_parser
-from cogmap.dvbf.navigate import (
-    execute,
-    grid_poses,
-    learn_model,
-    learned_scan_fn,
-    navigate_pairs,
-    navigate_run,
-    pose_pairs,
-    summarise,
-)
+from cogmap.dvbf.navigate import learn_model, navigate_pairs, navigate_run, summarise
 from cogmap.envs.maze import make_maze
+from cogmap.envs.maze_poses import execute, grid_poses, pose_pairs
 from cogmap.envs.maze_sim import MazeSim
+from cogmap.genmodel.dvbf_scan import learned_scan_fn
 from cogmap.planning.hybrid_astar import HybridAStarConfig, plan_path
 
 
@@ -131,7 +124,7 @@ def test_study_specs_are_blocks_of_pairs():
     assert len({s["key"] for s in full}) == len(full)
     with pytest.raises(ValueError, match="methods"):
         study_plan("dvbf-navigation", "full", methods=["dijkstra"])
-    from cogmap.dvbf.navigate import ENCODER
+    from cogmap.inference.goal_encoding import ENCODER
     from cogmap.study.dvbf_navigation import ENCODER as STUDY_ENCODER
 
     assert STUDY_ENCODER["full"] == ENCODER  # the study searches goal poses as cogmap dvbf navigate does
