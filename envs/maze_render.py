@@ -72,3 +72,48 @@ def maze_image(maze: Maze, pose=None, path=None, resolution: int = 200) -> np.nd
         i, j = _px(pose)
         img[max(i - 2, 0):i + 3, max(j - 2, 0):j + 3] = (220, 0, 0)
     return np.ascontiguousarray(np.transpose(img, (1, 0, 2))[::-1])
+
+
+def save_plans_png(maze: Maze, paths: dict, filename, radius: float, n: int = 4) -> None:
+    """Planned (dashed) and executed (solid) paths of the first ``n`` pairs, learned model beside the
+    true simulator (paper Figure 6a-b).
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze drawn underneath.
+    paths : dict
+        Model name -> ``[(pair, Plan, executed (n, 3), goal (3,))]`` (``extra["paths"]`` of
+        :func:`cogmap.dvbf.navigate.navigate_pairs`); only ``learned`` and ``true`` are drawn.
+    filename : path
+        PNG file to write.
+    radius : float
+        Success radius drawn around each goal (maze units).
+    n : int
+        Pairs drawn per panel.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    names = [k for k in ("learned", "true") if k in paths]  # learned_mean is in pairs.csv, not drawn
+    fig, axes = plt.subplots(1, len(names), figsize=(5 * len(names), 5), squeeze=False)
+    colours = plt.get_cmap("tab10").colors
+    try:
+        for ax, name in zip(axes[0], names, strict=True):
+            where = "the learned model" if name == "learned" else "the true simulator"
+            draw_maze(maze, ax, title=f"maze {maze.seed}: planned in {where} (dashed), executed (solid)")
+            ax.title.set_fontsize(8)
+            for k, ((i, j), plan, executed, goal) in enumerate(paths[name][:n]):
+                c = colours[k % len(colours)]
+                if plan.found:
+                    ax.plot(plan.poses[:, 0], plan.poses[:, 1], "--", c=c, lw=1.2)
+                ax.plot(executed[:, 0], executed[:, 1], "-", c=c, lw=0.8, alpha=0.8, label=f"{i} -> {j}")
+                ax.plot(*executed[0, :2], "o", c=c, ms=4)
+                ax.add_patch(plt.Circle(goal[:2], radius, fc="none", ec=c, lw=0.8))
+            ax.legend(loc="upper right", fontsize=7)
+        fig.tight_layout()
+        fig.savefig(filename, dpi=110)
+    finally:
+        plt.close(fig)

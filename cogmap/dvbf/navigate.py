@@ -25,6 +25,7 @@ import numpy as np
 
 from cogmap.envs.maze import Maze, make_maze
 from cogmap.envs.maze_poses import GRID, execute, grid_poses, pose_pairs
+from cogmap.envs.maze_render import save_plans_png
 from cogmap.genmodel.dvbf_scan import scan_models
 from cogmap.genmodel.numerics import wrap_angle
 from cogmap.inference.goal_encoding import encode_goals
@@ -258,8 +259,9 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     grid : int
         Poses per side.
     observation_goals : bool
-        Also plan pose-to-observation: to the pose :func:`cogmap.inference.goal_encoding.encode_goals` finds for each goal's scan, in the
-        ``learned`` reading (world ``observation``; success still at the true goal).
+        Also plan pose-to-observation: to the pose
+        :func:`cogmap.inference.goal_encoding.encode_goals` finds for each goal's scan, in the ``learned`` reading (world
+        ``observation``; success still at the true goal).
 
     Returns
     -------
@@ -339,49 +341,4 @@ def _write_run(out: Path, maze, params, cfg, poses, rows, paths, metrics, config
         for r in rows:
             w.writerow({k: (round(v, 6) if isinstance(v, float) else v) for k, v in r.items()})
     (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
-    save_paths_png(maze, paths, out / "paths.png")
-
-
-def save_paths_png(maze: Maze, paths: dict, filename, n: int = 4) -> None:
-    """Planned (dashed) and executed (solid) paths of the first ``n`` pairs, learned model beside the
-    true simulator (paper Figure 6a-b).
-
-    Parameters
-    ----------
-    maze : Maze
-        The maze drawn underneath.
-    paths : dict
-        Model name -> ``[(pair, Plan, executed (n, 3), goal (3,))]`` (``extra["paths"]`` of
-        :func:`navigate_pairs`); only ``learned`` and ``true`` are drawn.
-    filename : path
-        PNG file to write.
-    n : int
-        Pairs drawn per panel.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    from cogmap.envs.maze_render import draw_maze
-
-    names = [k for k in ("learned", "true") if k in paths]  # learned_mean is in pairs.csv, not drawn
-    fig, axes = plt.subplots(1, len(names), figsize=(5 * len(names), 5), squeeze=False)
-    colours = plt.get_cmap("tab10").colors
-    try:
-        for ax, name in zip(axes[0], names, strict=True):
-            where = "the learned model" if name == "learned" else "the true simulator"
-            draw_maze(maze, ax, title=f"maze {maze.seed}: planned in {where} (dashed), executed (solid)")
-            ax.title.set_fontsize(8)
-            for k, ((i, j), plan, executed, goal) in enumerate(paths[name][:n]):
-                c = colours[k % len(colours)]
-                if plan.found:
-                    ax.plot(plan.poses[:, 0], plan.poses[:, 1], "--", c=c, lw=1.2)
-                ax.plot(executed[:, 0], executed[:, 1], "-", c=c, lw=0.8, alpha=0.8, label=f"{i} -> {j}")
-                ax.plot(*executed[0, :2], "o", c=c, ms=4)
-                ax.add_patch(plt.Circle(goal[:2], SUCCESS_RADIUS, fc="none", ec=c, lw=0.8))
-            ax.legend(loc="upper right", fontsize=7)
-        fig.tight_layout()
-        fig.savefig(filename, dpi=110)
-    finally:
-        plt.close(fig)
+    save_plans_png(maze, paths, out / "paths.png", SUCCESS_RADIUS)
