@@ -260,8 +260,8 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
         Poses per side.
     observation_goals : bool
         Also plan pose-to-observation: to the pose
-        :func:`cogmap.inference.goal_encoding.encode_goals` finds for each goal's scan, in the ``learned`` reading (world
-        ``observation``; success still at the true goal).
+        :func:`cogmap.inference.goal_encoding.encode_goals` finds for each goal's scan, in the ``learned`` reading
+        (world ``observation``; success still at the true goal).
 
     Returns
     -------
