@@ -4,7 +4,7 @@ same messages."""
 
 from __future__ import annotations
 
-from collections.abc import Container, Mapping
+from collections.abc import Callable, Container, Mapping
 
 from .contracts import check_conforms
 
@@ -75,6 +75,59 @@ def check_entry(func: str, kind: str, name: str, obj, table: Mapping, builtin: C
         raise ValueError(f"{func}: '{name}' is a built-in {kind}; choose another name")
     if name in table and not overwrite and not again:
         raise ValueError(f"{func}: a {kind} named '{name}' exists (pass overwrite=True)")
+
+
+def accepts_test(func: str, accepts) -> Callable[[object], bool]:
+    """The model test of an entry registered with ``accepts`` (a type, a tuple of types, a callable
+    ``accepts(model) -> bool``, or None for every model).
+
+    Parameters
+    ----------
+    func : str
+        The registering function, for the message.
+    accepts : type, tuple of types, callable or None
+        What the entry handles.
+
+    Returns
+    -------
+    callable
+        ``test(model) -> bool``.
+
+    Raises
+    ------
+    TypeError
+        ``accepts`` is none of these.
+    """
+    if accepts is None:
+        return lambda model: True
+    if isinstance(accepts, type) or (isinstance(accepts, tuple) and accepts
+                                     and all(isinstance(t, type) for t in accepts)):
+        return lambda model: isinstance(model, accepts)
+    if callable(accepts):
+        return accepts
+    raise TypeError(f"{func}: accepts must be a model type, a tuple of types or a callable "
+                    f"accepts(model) -> bool, got {type(accepts).__name__}")
+
+
+def passes(test: Callable[[object], bool], model) -> bool:
+    """``test(model)``, where a test that fails on a model of another kind (say, reading
+    ``model.factors`` of a particle model) counts as not accepting it.
+
+    Parameters
+    ----------
+    test : callable
+        From :func:`accepts_test`.
+    model : object
+        Any model.
+
+    Returns
+    -------
+    bool
+    """
+    try:
+        return bool(test(model))
+    except Exception:  # noqa: BLE001 - a user's test may assume its own model type
+        return False
 
 
 class Registry:

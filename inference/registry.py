@@ -11,24 +11,13 @@ import inspect
 from collections.abc import Callable
 
 from cogmap.genmodel.contracts import InferenceScheme, check_conforms
+from cogmap.genmodel.registry import accepts_test, passes
 
 #: the arguments every scheme takes; anything else it accepts is one of its options
 CALL = ("model", "prior", "observations", "actions")
 
 _SCHEMES: dict[str, Callable] = {}
 _ACCEPTS: dict[str, Callable[[object], bool]] = {}
-
-
-def _accepts_test(name: str, accepts) -> Callable[[object], bool]:
-    if accepts is None:
-        return lambda model: True
-    if isinstance(accepts, type) or (isinstance(accepts, tuple) and accepts
-                                     and all(isinstance(t, type) for t in accepts)):
-        return lambda model: isinstance(model, accepts)
-    if callable(accepts):
-        return accepts
-    raise TypeError(f"register('{name}'): accepts must be a model type, a tuple of types or a callable "
-                    f"accepts(model) -> bool, got {type(accepts).__name__}")
 
 
 def register(name: str, fn: Callable | None = None, *, accepts=None, overwrite: bool = False):
@@ -65,7 +54,7 @@ def register(name: str, fn: Callable | None = None, *, accepts=None, overwrite: 
     """
     if not isinstance(name, str) or not name:
         raise ValueError("register: name must be a non-empty string")
-    test = _accepts_test(name, accepts)
+    test = accepts_test(f"register('{name}')", accepts)
 
     def _add(f: Callable) -> Callable:
         if not callable(f):
@@ -173,12 +162,7 @@ def accepting(model) -> tuple[str, ...]:
 
 
 def _test(name: str, model) -> bool:
-    """The scheme's ``accepts`` on ``model``; a test that fails on a model of another kind (say,
-    reading ``model.factors`` of a particle model) counts as not accepting it."""
-    try:
-        return bool(_ACCEPTS[name](model))
-    except Exception:  # noqa: BLE001 - a user's test may assume its own model type
-        return False
+    return passes(_ACCEPTS[name], model)
 
 
 def options(name: str) -> tuple[str, ...] | None:

@@ -39,6 +39,7 @@ from .mcts import MCTSConfig, SearchResult, mcts, ucb_select
 from .planners import (
     Plan,
     PlanSettings,
+    accepting_planners,
     available_planners,
     get_planner,
     register_planner,
@@ -65,6 +66,7 @@ __all__ = [
     "a_novelty",
     "astar_graph",
     "astar_grid",
+    "accepting_planners",
     "available_planners",
     "available_terms",
     "b_novelty",

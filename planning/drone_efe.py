@@ -6,7 +6,11 @@ it by factors >= 1, so a larger factor favours a candidate.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
+
+from .efe import Objective
 
 MAX_DISTANCE = 125.0
 W_PRAGMATIC = 1.0  # ActionPlanner defaults of the paper
@@ -68,17 +72,60 @@ def novelty(waypoints, visited, width: float = NOVELTY_WIDTH, prior_count: float
     return prior_count / (prior_count + n)
 
 
+class DroneStep(NamedTuple):
+    """Step context of ``K`` candidate waypoints for the drone's EFE terms.
+
+    Attributes
+    ----------
+    preference : numpy.ndarray
+        ``(K,)`` combined preference of each waypoint (:func:`preference`).
+    bonus : numpy.ndarray
+        ``(K,)`` distance bonus (:func:`distance_bonus`).
+    magnitude : numpy.ndarray
+        ``(K,)`` step length ``|a|`` (m) times the novelty ``eta`` of the waypoint (1 without novelty).
+    entropy_sum : float
+        ``H_d + H_az + H_el`` of the kernel beliefs (nats).
+    """
+
+    preference: np.ndarray
+    bonus: np.ndarray
+    magnitude: np.ndarray
+    entropy_sum: float
+
+    @property
+    def num_candidates(self) -> int:
+        return len(self.magnitude)
+
+
+def drone_pragmatic(ctx: DroneStep) -> np.ndarray:
+    """Pragmatic value ``(pref + bonus) |a| eta`` of each waypoint (DRONE.md 2.5)."""
+    return (ctx.preference + ctx.bonus) * ctx.magnitude
+
+
+def drone_epistemic(ctx: DroneStep) -> np.ndarray:
+    """Epistemic value ``0.5 (H_d + H_az + H_el) |a| eta`` of each waypoint (DRONE.md 2.5)."""
+    return 0.5 * ctx.entropy_sum * ctx.magnitude
+
+
+def drone_objective(w_pragmatic: float = W_PRAGMATIC, w_epistemic: float = W_EPISTEMIC) -> Objective:
+    """The drone's EFE as an :class:`~cogmap.planning.efe.Objective`:
+    ``G = -w_prag drone_pragmatic - w_epi drone_epistemic`` per waypoint."""
+    return Objective(((drone_pragmatic, float(w_pragmatic)), (drone_epistemic, float(w_epistemic))))
+
+
 def efe(pref, bonus, magnitude, entropy_sum: float, w_pragmatic: float = W_PRAGMATIC,
-        w_epistemic: float = W_EPISTEMIC, novelty=1.0):
+        w_epistemic: float = W_EPISTEMIC, novelty=1.0, objective: Objective | None = None):
     """G = eta (-w_prag (pref + bonus) |a| - w_epi 0.5 (H_d + H_az + H_el) |a|); returns (G, pragmatic,
     epistemic). With ``novelty`` eta = 1 this is the paper's EFE: the entropies are the same for
     every candidate, so the epistemic term rewards step length. With eta < 1 (:func:`novelty`, per
     candidate) both terms decay at places already visited: the information still to gain there is
     smaller, and the preference for a predicted state is discounted by how often the drone has
-    already been there (inhibition of return)."""
+    already been there (inhibition of return). The two parts are the terms of
+    :func:`drone_objective` (``objective``, default built from the two weights)."""
     m = np.asarray(magnitude, float) * np.asarray(novelty, float)
-    prag = -w_pragmatic * (np.asarray(pref, float) + np.asarray(bonus, float)) * m
-    epi = -w_epistemic * 0.5 * float(entropy_sum) * m
+    ctx = DroneStep(np.asarray(pref, float), np.asarray(bonus, float), m, float(entropy_sum))
+    parts = (objective or drone_objective(w_pragmatic, w_epistemic)).breakdown(ctx)
+    prag, epi = parts["drone_pragmatic"], parts["drone_epistemic"]
     return prag + epi, prag, epi
 
 

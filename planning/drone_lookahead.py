@@ -43,7 +43,7 @@ def _segment_distance(a, b, V) -> float:
     return float(np.sqrt((((V - a) - t[:, None] * ab) ** 2).sum(1).min()))
 
 
-def _value(pos, tgt, V, entropy_sum, d_start, rng, cfg, look, depth, visited) -> float:
+def _value(pos, tgt, V, entropy_sum, d_start, rng, cfg, look, depth, visited, objective) -> float:
     """Best discounted sum of shaped EFE over ``depth`` more steps from ``pos`` (lower is better);
     ``visited`` holds the positions visited before ``pos`` (the sequence's own earlier steps included)."""
     d_obs = clearance(pos, V)
@@ -51,7 +51,7 @@ def _value(pos, tgt, V, entropy_sum, d_start, rng, cfg, look, depth, visited) ->
     s = float(suitability(d_obs, rho))
     if np.linalg.norm(tgt - pos) <= 1.5:
         return 0.0
-    res = plan_waypoints(pos, tgt, V, d_obs, rho, s, entropy_sum, d_start, rng, cfg, visited)
+    res = plan_waypoints(pos, tgt, V, d_obs, rho, s, entropy_sum, d_start, rng, cfg, visited, objective)
     best = 0.0
     for w, g in zip(res.actions[: look.beam], res.efe[: look.beam], strict=False):
         if _segment_distance(pos, w, V) < look.segment_margin:
@@ -59,14 +59,15 @@ def _value(pos, tgt, V, entropy_sum, d_start, rng, cfg, look, depth, visited) ->
         v = float(g)
         if depth > 1:
             v += look.discount * _value(w, tgt, V, entropy_sum, d_start, rng, cfg, look, depth - 1,
-                                        np.vstack([visited, pos]))
+                                        np.vstack([visited, pos]), objective)
         best = min(best, v)
     return best
 
 
 def plan_sequence(position, target, voxels, d_obs: float, rho: float, s_now: float, entropy_sum: float,
                   d_start: float, rng: np.random.Generator, config: DronePlannerConfig | None = None,
-                  lookahead: LookaheadConfig | None = None, visited=None) -> tuple[PlanResult, np.ndarray]:
+                  lookahead: LookaheadConfig | None = None, visited=None,
+                  objective=None) -> tuple[PlanResult, np.ndarray]:
     """One decision with lookahead; returns the one-step :class:`PlanResult` reordered by sequence
     value (the first action is the one to fly) and the sequence values of its actions. ``visited``
     (K, 3): positions of the episode's earlier decisions (the novelty of the epistemic term); each
@@ -77,7 +78,7 @@ def plan_sequence(position, target, voxels, d_obs: float, rho: float, s_now: flo
     tgt = np.asarray(target, float)
     V = np.asarray(voxels, float).reshape(-1, 3)
     visited = np.zeros((0, 3)) if visited is None else np.asarray(visited, float).reshape(-1, 3)
-    first = plan_waypoints(pos, tgt, V, d_obs, rho, s_now, entropy_sum, d_start, rng, cfg, visited)
+    first = plan_waypoints(pos, tgt, V, d_obs, rho, s_now, entropy_sum, d_start, rng, cfg, visited, objective)
     n = min(len(first.actions), look.beam)
     values = np.zeros(n)
     ok = np.ones(n, bool)
@@ -87,7 +88,7 @@ def plan_sequence(position, target, voxels, d_obs: float, rho: float, s_now: flo
         values[i] = float(first.efe[i])
         if look.depth > 1:
             values[i] += look.discount * _value(w, tgt, V, entropy_sum, d_start, rng, cfg, look, look.depth - 1,
-                                                np.vstack([visited, pos]))
+                                                np.vstack([visited, pos]), objective)
     if not ok.any():
         return first, values
     idx = np.flatnonzero(ok)

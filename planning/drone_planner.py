@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -78,14 +79,46 @@ class PlanResult:
     efe_us_per_candidate: float  # microseconds of the EFE (preference, EFE, shaping) per candidate
 
 
+class DroneScene(NamedTuple):
+    """What the drone plans from: the ``model`` argument of the ``"drone"`` planner
+    (:func:`cogmap.planning.drone_lookahead.drone_planner`).
+
+    Attributes
+    ----------
+    position, target : numpy.ndarray
+        ``(3,)`` metres, world frame.
+    voxels : numpy.ndarray
+        ``(M, 3)`` obstacle voxel centres the drone perceives, metres.
+    clearance, density, suitability : float
+        The current ``d_obs`` (m), ``rho`` and ``S``.
+    d_start : float
+        Distance to the target at the start of the episode (journey bonus), metres.
+    visited : numpy.ndarray
+        ``(K, 3)`` positions of the episode's earlier decisions (novelty).
+    config : DronePlannerConfig
+        Planner settings.
+    """
+
+    position: np.ndarray
+    target: np.ndarray
+    voxels: np.ndarray
+    clearance: float
+    density: float
+    suitability: float
+    d_start: float
+    visited: np.ndarray
+    config: DronePlannerConfig
+
+
 def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: float, entropy_sum: float,
                    d_start: float, rng: np.random.Generator, config: DronePlannerConfig | None = None,
-                   visited=None) -> PlanResult:
+                   visited=None, objective=None) -> PlanResult:
     """The planning step; see the module docstring. ``voxels`` are obstacle voxel centres (M, 3),
     ``d_obs``, ``rho``, ``s_now`` the current clearance, density and suitability, ``d_start`` the
     distance to the target at the start of the episode (journey bonus), ``visited`` the positions
     (K, 3) of the earlier decisions of the episode (the novelty of the epistemic term; none: every
-    candidate is novel)."""
+    candidate is novel), ``objective`` the EFE (:func:`~.drone_efe.drone_objective`; default built
+    from the config's two weights)."""
     cfg = config or DronePlannerConfig()
     pos = np.asarray(position, float)
     tgt = np.asarray(target, float)
@@ -120,7 +153,8 @@ def plan_waypoints(position, target, voxels, d_obs: float, rho: float, s_now: fl
     el = np.arctan2(to_t[:, 2], np.hypot(to_t[:, 0], to_t[:, 1])) - pitch
     pref = E.preference(d_new, az, el, S, cfg.tau)
     eta = E.novelty(W, visited, cfg.novelty_width) if cfg.novelty else 1.0
-    G, _, _ = E.efe(pref, E.distance_bonus(d_now, d_new), mag, entropy_sum, cfg.w_pragmatic, cfg.w_epistemic, eta)
+    G, _, _ = E.efe(pref, E.distance_bonus(d_now, d_new), mag, entropy_sum, cfg.w_pragmatic, cfg.w_epistemic, eta,
+                    objective)
     G = E.shape(G, S, d_now, d_new, mag, rho, d_obs, d_start)
     efe_us = 1e6 * (time.perf_counter() - t0) / max(len(W), 1)
     long_enough = np.flatnonzero(mag >= cfg.min_step)

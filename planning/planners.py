@@ -14,9 +14,11 @@ A planner is any callable
 returning a :class:`Plan`: ``action`` (one integer control per factor), ``G`` (the EFE of what
 was compared: per policy, per root action, ...) and optionally ``q_pi`` and ``policies``.
 :mod:`cogmap.loop` calls it once per step, after inference and learning, and looks it up by the
-name given to ``loop.init(planner=...)``. Two are built in: ``"enumerate"`` (every policy of
-``policy_len`` steps, :func:`~.policies.infer_policies`) and ``"mcts"`` (:func:`~.decide.decide`).
-Add yours with :func:`register_planner` without touching this package.
+name given to ``loop.init(planner=...)``. Three are built in: ``"enumerate"`` (every policy of
+``policy_len`` steps, :func:`~.policies.infer_policies`), ``"mcts"`` (:func:`~.decide.decide`) and
+``"drone"`` (the drone's waypoint ranking, looking ``policy_len`` waypoints ahead, on a
+:class:`~.drone_planner.DroneScene`, :func:`drone_planner`). Add yours with :func:`register_planner`
+without touching this package; :func:`accepting_planners` lists those that take a given model.
 """
 
 from __future__ import annotations
@@ -27,8 +29,13 @@ from typing import NamedTuple
 import numpy as np
 
 from cogmap.genmodel import contracts
-from cogmap.genmodel.registry import check_entry, check_name
+from cogmap.genmodel.drone_beliefs import entropy
+from cogmap.genmodel.model import Model
+from cogmap.genmodel.registry import accepts_test, check_entry, check_name, passes
 
+from .arrays import PlanningArrays
+from .drone_lookahead import LookaheadConfig, plan_sequence
+from .drone_planner import DroneScene, plan_waypoints
 from .mcts import MCTSConfig
 
 
@@ -69,20 +76,24 @@ class Plan(NamedTuple):
         Posterior over those policies, if the planner has one.
     policies : numpy.ndarray or None
         ``(P, T, F)`` policies of ``q_pi`` and ``G`` (enumeration).
+    info : object or None
+        The planner's own record of the decision (the drone's ``PlanResult``).
     """
 
     action: tuple  # one integer control per factor, to apply now
     G: np.ndarray  # expected free energy of what was compared (per policy, per root action, ...)
     q_pi: np.ndarray | None = None  # posterior over those policies, if the planner has one
     policies: np.ndarray | None = None  # (P, T, F) policies of q_pi and G (enumeration)
+    info: object = None  # the planner's own record of the decision (the drone's PlanResult)
 
 
 Planner = Callable[..., Plan]
 
 _PLANNERS: dict[str, Planner] = {}
+_ACCEPTS: dict[str, Callable[[object], bool]] = {}
 
 
-def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = False):
+def register_planner(name: str, fn: Planner | None = None, *, accepts=None, overwrite: bool = False):
     """Register planner ``fn`` under ``name``; usable as a decorator (``@register_planner("mine")``).
 
     Parameters
@@ -92,6 +103,8 @@ def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = 
     fn : callable, optional
         ``fn(model, qs, objective, settings) -> Plan`` (module docstring). Omitted: returns a
         decorator.
+    accepts : type, tuple of types or callable, optional
+        The models it plans with (a type, types, or ``accepts(model) -> bool``); default every model.
     overwrite : bool
         Replace a planner registered under ``name`` (the built-in ``"enumerate"`` and
         ``"mcts"`` cannot be replaced).
@@ -107,14 +120,16 @@ def register_planner(name: str, fn: Planner | None = None, *, overwrite: bool = 
         Empty name, a built-in name, or a name already taken without ``overwrite``.
     TypeError
         ``fn`` is not callable or cannot be called as ``fn(model, qs, objective, settings)``
-        (:class:`cogmap.genmodel.contracts.Planner`).
+        (:class:`cogmap.genmodel.contracts.Planner`), or ``accepts`` is neither a type nor a callable.
     """
     check_name("register_planner", name)
+    test = accepts_test(f"register_planner('{name}')", accepts)
 
     def _add(f: Planner) -> Planner:
         check_entry("register_planner", "planner", name, f, _PLANNERS, BUILTIN, overwrite,
                     protocol=contracts.Planner)
         _PLANNERS[name] = f
+        _ACCEPTS[name] = test
         return f
 
     return _add if fn is None else _add(fn)
@@ -140,6 +155,7 @@ def unregister_planner(name: str) -> None:
     if name not in _PLANNERS:
         raise KeyError(f"no planner named '{name}' (available: {', '.join(available_planners())})")
     del _PLANNERS[name]
+    _ACCEPTS.pop(name, None)
 
 
 def get_planner(name: str) -> Planner:
@@ -234,8 +250,72 @@ def mcts_planner(model, qs, objective, settings: PlanSettings) -> Plan:
     return Plan(tuple(int(x) for x in a) + (0,) * (num_factors - a.size), np.asarray(d.Q))
 
 
-BUILTIN = {"enumerate": enumerate_planner, "mcts": mcts_planner}
-_PLANNERS.update(BUILTIN)
+def drone_planner(model: DroneScene, qs, objective, settings):
+    """The ``"drone"`` planner: the paper's one-step waypoint
+    ranking (:func:`~.drone_planner.plan_waypoints`) when ``settings.policy_len`` is 1, else
+    :func:`~.drone_lookahead.plan_sequence` looking ``policy_len`` waypoints ahead.
 
-__all__ = ["Plan", "PlanSettings", "available_planners", "enumerate_planner", "get_planner", "mcts_planner",
-           "register_planner", "unregister_planner"]
+    Parameters
+    ----------
+    model : DroneScene
+        Position, target, perceived voxels, clearance, density, suitability, start distance,
+        visited positions and the planner config.
+    qs : sequence of numpy.ndarray
+        The kernel beliefs (distance, azimuth, elevation first; their entropies are the epistemic
+        term's ``H_d + H_az + H_el``).
+    objective : Objective or None
+        The EFE (:func:`~.drone_efe.drone_objective`); None builds it from the config's weights.
+    settings : PlanSettings
+        ``policy_len`` (the depth) and ``rng`` (the candidates' generator, required).
+
+    Returns
+    -------
+    Plan
+        ``action``: the ``(3,)`` waypoint to fly; ``G``: the EFE (one step) or sequence value of the
+        returned waypoints, best first; ``policies``: those waypoints ``(K, 3)``; ``info``: the
+        :class:`~.drone_planner.PlanResult`.
+
+    Raises
+    ------
+    ValueError
+        ``settings.rng`` is None or ``settings.policy_len`` < 1.
+    """
+    if settings.rng is None or settings.policy_len < 1:
+        raise ValueError(f"drone_planner: needs settings.rng and policy_len >= 1, got rng={settings.rng!r}, "
+                         f"policy_len={settings.policy_len}")
+    m = model
+    h = entropy(qs[0]) + entropy(qs[1]) + entropy(qs[2])
+    args = (m.position, m.target, m.voxels, m.clearance, m.density, m.suitability, h, m.d_start, settings.rng,
+            m.config)
+    if settings.policy_len > 1:
+        plan, G = plan_sequence(*args, LookaheadConfig(depth=settings.policy_len), m.visited, objective)
+    else:
+        plan = plan_waypoints(*args, m.visited, objective)
+        G = plan.efe
+    return Plan(plan.actions[0], np.asarray(G), None, plan.actions, plan)
+
+
+def accepting_planners(model) -> tuple[str, ...]:
+    """Names of the planners that plan with ``model`` (their ``accepts``), sorted.
+
+    Parameters
+    ----------
+    model : object
+        A compiled :class:`~cogmap.genmodel.Model`, :class:`~.arrays.PlanningArrays`, a
+        :class:`~.drone_planner.DroneScene`, or a user's model.
+
+    Returns
+    -------
+    tuple of str
+    """
+    return tuple(n for n in available_planners() if passes(_ACCEPTS[n], model))
+
+
+BUILTIN = {"enumerate": enumerate_planner, "mcts": mcts_planner, "drone": drone_planner}
+_PLANNERS.update(BUILTIN)
+_ACCEPTS.update({"enumerate": accepts_test("planners", (Model, PlanningArrays)),
+                 "mcts": accepts_test("planners", (Model, PlanningArrays)),
+                 "drone": accepts_test("planners", DroneScene)})
+
+__all__ = ["Plan", "PlanSettings", "accepting_planners", "available_planners", "drone_planner", "enumerate_planner",
+           "get_planner", "mcts_planner", "register_planner", "unregister_planner"]

@@ -24,8 +24,9 @@ from cogmap.genmodel.drone_beliefs import (
     normalised_entropy,
 )
 from cogmap.genmodel.suitability import MIN_POINTS, VOXEL_SIZE, clearance, density, suitability, voxelise
-from cogmap.planning.drone_lookahead import LookaheadConfig, plan_sequence
-from cogmap.planning.drone_planner import DronePlannerConfig, PlanResult, plan_waypoints
+from cogmap.planning.drone_efe import drone_objective
+from cogmap.planning.drone_planner import DronePlannerConfig, DroneScene, PlanResult
+from cogmap.planning.planners import PlanSettings, get_planner
 
 SENSE_RADIUS = 20.0  # the LiDAR's range: only voxels this close describe the current state
 
@@ -253,6 +254,8 @@ class DroneAgent(DronePolicy):
         self.config = config or DroneAgentConfig()
         self.model = KernelBeliefModel()
         self.scheme = inference.get("kernel")
+        self.planner = get_planner("drone")
+        self.objective = drone_objective(self.config.planner.w_pragmatic, self.config.planner.w_epistemic)
         self.rng = np.random.default_rng(seed)
         self.speeds = speeds
         self.reset()
@@ -355,13 +358,10 @@ class DroneAgent(DronePolicy):
         beliefs, _ = self.scheme(self.model, prior, [obs])
         self.beliefs = beliefs
         H = [entropy(b) for b in beliefs]
-        visited = np.array(self.visited).reshape(-1, 3)
-        if self.config.depth > 1:
-            plan, _ = plan_sequence(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
-                                    self.config.planner, LookaheadConfig(depth=self.config.depth), visited)
-        else:
-            plan = plan_waypoints(pos, tgt, V, d_obs, rho, S, H[0] + H[1] + H[2], self.d_start, self.rng,
-                                  self.config.planner, visited)
+        scene = DroneScene(pos, tgt, V, d_obs, rho, S, self.d_start, np.array(self.visited).reshape(-1, 3),
+                           self.config.planner)
+        settings = PlanSettings(policy_len=self.config.depth, rng=self.rng)
+        plan = self.planner(scene, beliefs, self.objective, settings).info
         plan_ms = 1e3 * (time.perf_counter() - t0)
         self.visited.append(pos.copy())
         d_tgt = float(np.linalg.norm(tgt - pos))

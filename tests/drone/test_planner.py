@@ -172,3 +172,53 @@ def test_lookahead_adds_the_best_continuation_and_prunes_blocked_segments():
     blocked, _ = plan_sequence(pos, tgt, pole, d_obs, density(pos, pole), suitability(d_obs, 0.0), 6.0, 40.0,
                                np.random.default_rng(0), lookahead=LookaheadConfig(depth=2))
     assert all(_segment_distance(pos, w, pole) >= 0.5 for w in blocked.actions)
+
+
+def test_drone_efe_is_the_objective_of_its_two_terms():
+    rng = np.random.default_rng(3)
+    pref, bonus, m, eta = rng.random(30), rng.random(30), 5 * rng.random(30), rng.random(30)
+    G, prag, epi = E.efe(pref, bonus, m, 6.0, 1.0, 0.2, eta)
+    ctx = E.DroneStep(pref, bonus, m * eta, 6.0)
+    obj = E.drone_objective(1.0, 0.2)
+    assert obj.names == ("drone_pragmatic", "drone_epistemic")
+    np.testing.assert_array_equal(G, obj(ctx))
+    # the closed form, DRONE.md 2.5 (to rounding: the factors are multiplied in another order)
+    np.testing.assert_allclose(prag, -(pref + bonus) * m * eta, rtol=1e-15)
+    np.testing.assert_allclose(epi, -0.2 * 0.5 * 6.0 * m * eta, rtol=1e-15)
+    # a user's objective (here without the epistemic term) replaces the weights
+    G_prag, _, e0 = E.efe(pref, bonus, m, 6.0, 1.0, 0.2, eta, objective=E.drone_objective(1.0, 0.0))
+    np.testing.assert_array_equal(G_prag, prag)
+    assert (e0 == 0).all()
+
+
+@pytest.mark.parametrize("depth", [1, 2])
+def test_the_drone_planner_of_the_registry_is_the_one_step_ranking_or_the_lookahead(depth):
+    from cogmap.genmodel.drone_beliefs import KernelBeliefModel, entropy
+    from cogmap.inference import get
+    from cogmap.planning.drone_lookahead import LookaheadConfig, plan_sequence
+    from cogmap.planning.drone_planner import DroneScene
+    from cogmap.planning.planners import PlanSettings, accepting_planners, get_planner
+
+    pos, tgt = np.array([0.0, 0, 5]), np.array([0.0, 40, 5])
+    pole = np.stack([np.zeros(20), np.full(20, 1.0), np.linspace(0, 9, 20)], 1)
+    from cogmap.genmodel.suitability import clearance, density
+
+    d_obs, rho = clearance(pos, pole), density(pos, pole)
+    s_now = suitability(d_obs, rho)
+    beliefs, _ = get("kernel")(KernelBeliefModel(), None, [{"distance": 40.0, "azimuth": 0.0, "elevation": 0.0,
+                                                            "suitability": s_now, "density": rho}])
+    h = entropy(beliefs[0]) + entropy(beliefs[1]) + entropy(beliefs[2])
+    scene = DroneScene(pos, tgt, pole, d_obs, rho, s_now, 40.0, np.zeros((0, 3)), DronePlannerConfig())
+    assert accepting_planners(scene) == ("drone",)
+    plan = get_planner("drone")(scene, beliefs, None, PlanSettings(policy_len=depth, rng=np.random.default_rng(0)))
+    if depth == 1:
+        ref = plan_waypoints(pos, tgt, pole, d_obs, rho, s_now, h, 40.0, np.random.default_rng(0))
+        values = ref.efe
+    else:
+        ref, values = plan_sequence(pos, tgt, pole, d_obs, rho, s_now, h, 40.0, np.random.default_rng(0),
+                                    lookahead=LookaheadConfig(depth=2))
+    np.testing.assert_array_equal(plan.action, ref.actions[0])
+    np.testing.assert_array_equal(plan.policies, ref.actions)
+    np.testing.assert_array_equal(plan.G, values)
+    with pytest.raises(ValueError, match="needs settings.rng"):
+        get_planner("drone")(scene, beliefs, None, PlanSettings(policy_len=depth))
