@@ -7,8 +7,10 @@ belief update as the ``"kernel"`` inference scheme, waypoint generation, filteri
 ``cogmap.envs`` (:mod:`~cogmap.envs.drone_sim`).
 """
 
-from .agent import DroneAgent, DroneAgentConfig, VoxelMap
-from .baselines import PotentialField, StraightLine
+from cogmap.genmodel.voxel_map import VoxelMap
+from cogmap.planning.drone_policies import PotentialField, StraightLine
+
+from .agent import DroneAgent, DroneAgentConfig
 from .episode import EpisodeLimits, fly_episode, make_policy, summarise
 
 __all__ = ["DroneAgent", "DroneAgentConfig", "EpisodeLimits", "PotentialField", "StraightLine", "VoxelMap",

@@ -10,7 +10,6 @@ holds state (voxel memory, beliefs, RNG) and no maths.
 from __future__ import annotations
 
 import time
-from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -23,83 +22,12 @@ from cogmap.genmodel.drone_beliefs import (
     expected_state,
     normalised_entropy,
 )
-from cogmap.genmodel.suitability import MIN_POINTS, VOXEL_SIZE, clearance, density, suitability, voxelise
+from cogmap.genmodel.suitability import clearance, density, suitability
+from cogmap.genmodel.voxel_map import SENSE_RADIUS, VoxelMap
 from cogmap.planning.drone_efe import drone_objective
-from cogmap.planning.drone_planner import DronePlannerConfig, DroneScene, PlanResult
+from cogmap.planning.drone_planner import DronePlannerConfig, DroneScene
+from cogmap.planning.drone_policies import Decision, DronePolicy
 from cogmap.planning.planners import PlanSettings, get_planner
-
-SENSE_RADIUS = 20.0  # the LiDAR's range: only voxels this close describe the current state
-
-
-class VoxelMap:
-    """Obstacle voxels (0.15 m) of the last ``memory`` LiDAR scans.
-
-    ``memory=1`` is the original's per-scan view. With 400 rays a single sweep leaves 14.4 deg between
-    azimuths (1.3 m at 5 m range, enough to miss a trunk), and each scan turns the pattern by a
-    golden-ratio fraction of that spacing, so a short memory of recent scans (default 12, the scans
-    of about 2-3 planning steps with the in-flight ones) fills the gaps while keeping the voxel count,
-    and so the planning time, bounded. Voxels seen in several scans count once.
-
-    Parameters
-    ----------
-    voxel : float, optional
-        Voxel side, metres.
-    min_points : int, optional
-        Hits a voxel needs to count as an obstacle.
-    memory : int, optional
-        Number of recent scans kept, at least 1; default 12.
-
-    Raises
-    ------
-    ValueError
-        If ``memory < 1``.
-    """
-
-    def __init__(self, voxel: float = VOXEL_SIZE, min_points: int = MIN_POINTS, memory: int = 12):
-        if memory < 1:
-            raise ValueError(f"VoxelMap: memory must be >= 1 scan, got {memory}")
-        self.voxel, self.min_points = voxel, min_points
-        self.scans: deque = deque(maxlen=memory)
-        self._points = None
-
-    def add(self, hits) -> None:
-        """Add one scan's hit points (the oldest scan is forgotten when ``memory`` is full).
-
-        Parameters
-        ----------
-        hits : array_like
-            ``(N, 3)`` float hit points, metres, world frame.
-        """
-        self.scans.append(np.asarray(hits, float).reshape(-1, 3))
-        self._points = None
-
-    @property
-    def points(self) -> np.ndarray:
-        """``(V, 3)`` float obstacle voxels of the remembered scans (computed on first access)."""
-        if self._points is None:
-            pts = np.vstack(list(self.scans)) if self.scans else np.zeros((0, 3))
-            self._points = voxelise(pts, self.voxel, self.min_points)
-        return self._points
-
-    def near(self, position, radius: float = SENSE_RADIUS) -> np.ndarray:
-        """Voxels within ``radius`` of ``position``.
-
-        Parameters
-        ----------
-        position : array_like
-            ``(3,)`` metres.
-        radius : float, optional
-            Metres; default the LiDAR range (20 m).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(k, 3)`` float voxels.
-        """
-        P = self.points
-        if len(P) == 0:
-            return P
-        return P[((P - np.asarray(position, float)) ** 2).sum(1) <= radius * radius]
 
 
 @dataclass(frozen=True)
@@ -161,75 +89,6 @@ class DroneAgentConfig:
         from dataclasses import asdict
 
         return asdict(self)
-
-
-@dataclass
-class Decision:
-    waypoint: np.ndarray
-    speed: float
-    plan: PlanResult
-    plan_ms: float  # wall-clock of the whole planning call (beliefs + candidates + EFE + ranking)
-    state: dict  # d_obs, rho, S, expected state, entropies
-
-
-class DronePolicy:
-    """What an episode (:func:`cogmap.drone.episode.fly_episode`) calls on a drone policy:
-    ``reset``, ``observe`` (every LiDAR scan, also those taken in flight), ``observe_contact``,
-    ``decide``. By default a policy perceives LiDAR returns only and keeps them in its voxel map
-    when it has one (``voxels``); ``decide`` is each policy's own.
-    """
-
-    replans_in_flight = False
-    voxels: VoxelMap | None = None
-
-    def reset(self, target=None, start=None) -> None:
-        """Start an episode (nothing to forget by default).
-
-        Parameters
-        ----------
-        target : array_like, optional
-            ``(3,)`` target position, metres.
-        start : array_like, optional
-            ``(3,)`` start position, metres.
-        """
-
-    def observe(self, scan, position=None) -> None:
-        """Add a LiDAR scan to the voxel memory (ignored by a policy without one).
-
-        Parameters
-        ----------
-        scan : object
-            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
-        position : array_like, optional
-            Where the scan was taken (unused).
-        """
-        if self.voxels is not None:
-            self.voxels.add(scan.points)
-
-    def observe_contact(self, point) -> None:
-        """Ignore a collision's touched point (the default: LiDAR returns only).
-
-        Parameters
-        ----------
-        point : array_like
-            ``(3,)`` the touched point, metres, world frame (unused).
-        """
-
-    def decide(self, position, target) -> Decision:  # pragma: no cover - each policy's own
-        """The next waypoint and speed.
-
-        Parameters
-        ----------
-        position : array_like
-            ``(3,)`` current position, metres, world frame.
-        target : array_like
-            ``(3,)`` target position, metres.
-
-        Returns
-        -------
-        Decision
-        """
-        raise NotImplementedError
 
 
 class DroneAgent(DronePolicy):

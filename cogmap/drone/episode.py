@@ -70,8 +70,10 @@ def make_policy(method: str, seed: int = 0):
     """
     from dataclasses import replace
 
+    from cogmap.planning.drone_policies import PotentialField, StraightLine
+
     from .agent import DroneAgent, DroneAgentConfig
-    from .baselines import PotentialField, StraightLine
+
 
     base = DroneAgentConfig()
     if method == "agent":

@@ -1,4 +1,5 @@
-"""Drone baselines: straight-line flight and a potential field over the sensed voxels."""
+"""Drone policies: what an episode calls on one (:class:`DronePolicy`), the :class:`Decision` it
+returns, and two baselines: straight-line flight and a potential field over the sensed voxels."""
 
 from __future__ import annotations
 
@@ -6,7 +7,79 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .agent import Decision, DronePolicy, VoxelMap
+from cogmap.genmodel.voxel_map import VoxelMap
+
+from .drone_planner import PlanResult
+
+
+@dataclass
+class Decision:
+    waypoint: np.ndarray
+    speed: float
+    plan: PlanResult
+    plan_ms: float  # wall-clock of the whole planning call (beliefs + candidates + EFE + ranking)
+    state: dict  # d_obs, rho, S, expected state, entropies
+
+
+class DronePolicy:
+    """What an episode (:func:`cogmap.drone.episode.fly_episode`) calls on a drone policy:
+    ``reset``, ``observe`` (every LiDAR scan, also those taken in flight), ``observe_contact``,
+    ``decide``. By default a policy perceives LiDAR returns only and keeps them in its voxel map
+    when it has one (``voxels``); ``decide`` is each policy's own.
+    """
+
+    replans_in_flight = False
+    voxels: VoxelMap | None = None
+
+    def reset(self, target=None, start=None) -> None:
+        """Start an episode (nothing to forget by default).
+
+        Parameters
+        ----------
+        target : array_like, optional
+            ``(3,)`` target position, metres.
+        start : array_like, optional
+            ``(3,)`` start position, metres.
+        """
+
+    def observe(self, scan, position=None) -> None:
+        """Add a LiDAR scan to the voxel memory (ignored by a policy without one).
+
+        Parameters
+        ----------
+        scan : object
+            A LiDAR scan with ``points``, ``(N, 3)`` float hit points in metres, world frame.
+        position : array_like, optional
+            Where the scan was taken (unused).
+        """
+        if self.voxels is not None:
+            self.voxels.add(scan.points)
+
+    def observe_contact(self, point) -> None:
+        """Ignore a collision's touched point (the default: LiDAR returns only).
+
+        Parameters
+        ----------
+        point : array_like
+            ``(3,)`` the touched point, metres, world frame (unused).
+        """
+
+    def decide(self, position, target) -> Decision:  # pragma: no cover - each policy's own
+        """The next waypoint and speed.
+
+        Parameters
+        ----------
+        position : array_like
+            ``(3,)`` current position, metres, world frame.
+        target : array_like
+            ``(3,)`` target position, metres.
+
+        Returns
+        -------
+        Decision
+        """
+        raise NotImplementedError
+
 
 
 @dataclass
