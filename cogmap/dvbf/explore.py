@@ -270,9 +270,8 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
 
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_traversal import traverse
+    from cogmap.inference.dvbf_files import load_params, save_params
     from cogmap.inference.online_slam import pretrain_emission
-
-    from .model_files import load_params, save_params
 
     cache = None
     if cache_dir is not None:

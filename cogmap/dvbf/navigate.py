@@ -243,7 +243,7 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     complexity, corridor : str
         Maze family (Table II).
     model_dir : pathlib.Path, optional
-        A run directory to load the model from (:func:`~cogmap.dvbf.model_files.load_params`).
+        A run directory to load the model from (:func:`~cogmap.inference.dvbf_files.load_params`).
     map_steps, map_iters : int
         Traversal length and Adam steps of :func:`learn_model`.
     pretrain_maze : int, optional
@@ -281,7 +281,7 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     if model is not None:
         params, cfg, info = model
     elif model_dir is not None:
-        from .model_files import load_params
+        from cogmap.inference.dvbf_files import load_params
 
         params, cfg = load_params(Path(model_dir))
         info = {"source": f"run directory {model_dir}"}
@@ -326,9 +326,8 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
 
 
 def _write_run(out: Path, maze, params, cfg, poses, rows, paths, metrics, config, locals_) -> None:
+    from cogmap.inference.dvbf_files import save_params
     from cogmap.runs import write_manifest
-
-    from .model_files import save_params
 
     out.mkdir(parents=True, exist_ok=True)
     write_manifest(out, command="dvbf navigate", planner=json.loads(json.dumps(asdict(config))), **locals_)

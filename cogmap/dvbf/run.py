@@ -18,10 +18,10 @@ import numpy as np
 from cogmap.envs.maze import make_maze
 from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
+from cogmap.inference.dvbf_files import save_params
 from cogmap.inference.online_slam import SLAMConfig, online_slam, path_integration, pretrain_emission
 
 from .maze_model import NOISE, maze_model
-from .model_files import MAX_MODEL_JSON_BYTES, DVBFModelError, load_params, save_params  # noqa: F401  (importable from here)
 
 
 def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium",

@@ -154,7 +154,7 @@ def test_config_bounds_every_size_before_a_network_is_made(kwargs, message):
 
 
 def _saved_model(tmp_path):
-    from cogmap.dvbf.run import save_params
+    from cogmap.inference.dvbf_files import save_params
     from cogmap.inference.elbo import init_params
 
     cfg = DVBFConfig(map_side=4, n_radii=3, hidden=8, depth=1)
@@ -165,7 +165,7 @@ def _saved_model(tmp_path):
 
 
 def test_a_saved_model_loads_back(tmp_path):
-    from cogmap.dvbf.run import load_params
+    from cogmap.inference.dvbf_files import load_params
 
     cfg, arrays = _saved_model(tmp_path)
     params, back = load_params(tmp_path)
@@ -177,7 +177,7 @@ def test_a_saved_model_loads_back(tmp_path):
 def test_a_damaged_model_file_is_refused_naming_the_array_or_field(tmp_path, case):
     import json
 
-    from cogmap.dvbf.run import DVBFModelError, load_params
+    from cogmap.inference.dvbf_files import DVBFModelError, load_params
 
     _, arrays = _saved_model(tmp_path)
     meta = json.loads((tmp_path / "model.json").read_text())

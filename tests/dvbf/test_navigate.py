@@ -87,7 +87,7 @@ def test_navigate_run_directory(tmp_path, small_model):
         assert (out / name).is_file(), name
     assert json.loads((out / "metrics.json").read_text()) == json.loads(json.dumps(metrics))
     assert metrics["pairs"] == 1 and metrics["true"]["pairs"] == metrics["learned"]["pairs"] == 1
-    from cogmap.dvbf.run import load_params
+    from cogmap.inference.dvbf_files import load_params
 
     params, cfg = load_params(out)  # the model the plans used, as --model would read it back
     assert cfg == model[1] and np.allclose(np.asarray(params.q_map.mean), np.asarray(model[0].q_map.mean))

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 from cogmap.cli import build_parser
-from cogmap.dvbf.run import load_params, slam_run
+from cogmap.dvbf.run import slam_run
 from cogmap.envs.maze_sim import ActuationNoise
+from cogmap.inference.dvbf_files import load_params
 from cogmap.inference.online_slam import path_integration
 
 

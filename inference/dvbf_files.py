@@ -134,7 +134,7 @@ def load_params(out: Path):
     import equinox as eqx
     import jax
 
-    from cogmap.inference.elbo import init_params
+    from .elbo import init_params
 
     out = Path(out)
     cfg = _read_config(out / "model.json")
