@@ -69,8 +69,9 @@ def lattice_agent(n: int, seed: int = 0):
         onehot[s] = 0.0
     start = index[(side // 2, side // 2)] if (side // 2, side // 2) in index else n // 2
     agent = AIMAPPAgent(cfg, encoder=encoder, seed=seed, model=model)
-    agent.q = np.zeros(n)
-    agent.q[start] = 1.0
+    q = np.zeros(n)
+    q[start] = 1.0
+    agent.belief = agent.belief._replace(q=q)
     return agent, poses[start], side
 
 

@@ -130,6 +130,7 @@ def _exploration_schema() -> Struct:
     from cogmap.agent.correction import Anchor
     from cogmap.agent.encoder import SSIMEncoder
     from cogmap.agent.exploration_end import Done
+    from cogmap.agent.localisation import Belief, Counts, Memory
     from cogmap.agent.viewmap import ViewMap
     from cogmap.envs.robot import Odometry, OdometryNoise
     from cogmap.envs.sensors import STREAMS, FaultSchedule
@@ -165,15 +166,19 @@ def _exploration_schema() -> Struct:
         "unreached": count, "full": fin, "viewpoint": s.Optional(xy),
         "spent": s.ListOf(s.TupleOf(xy, fin)), "spent_at": count, "blind": s.Bool()})
     anchor = s.Record(Anchor, {"pose": xy, "panorama": s.Array("uif"), "scan": s.Array("f", 2), "step": count})
-    agent = s.Record(AIMAPPAgent, {
-        "cfg": config, "encoder": encoder, "rng": rng, "model": ModelFile(), "q": s.Array("f", 1),
-        "frame": s.Record(SE2, {"yaw": fin, "x": fin, "y": fin}, make="call"),
-        "anchors": s.DictOf(state, anchor), "corrections": count, "frame_moves": s.ListOf(Struct({
+    se2 = s.Record(SE2, {"yaw": fin, "x": fin, "y": fin}, make="call")
+    belief = s.Record(Belief, {"q": s.Array("f", 1), "frame": se2, "lost": s.Bool(),
+                               "lost_evidence": s.Float(finite=False), "last_obs": s.Optional(state),
+                               "outcome": s.Optional(s.Bool())}, make="call")
+    counts = s.Record(Counts, {k: count for k in Counts._fields}, make="call")
+    memory = s.Record(Memory, {
+        "anchors": s.DictOf(state, anchor), "scanned": s.SetOf(state),
+        "traversed": s.SetOf(s.TupleOf(state, state, state)), "frame_moves": s.ListOf(Struct({
             "step": count, "kind": s.Str(("correction", "relocalisation")), "moved_m": s.Float(0.0)})),
-        "last": s.Optional(decision), "goal_obs": s.Optional(state), "step_count": count,
-        "_outcome": s.Optional(s.Bool()), "lost": s.Bool(), "lost_evidence": s.Float(finite=False),
-        "lost_events": count, "last_obs": s.Optional(state), "relocalisations": count, "views": views,
-        "scanned": s.SetOf(state), "traversed": s.SetOf(s.TupleOf(state, state, state))})
+        "views": views}, make="call")
+    agent = s.Record(AIMAPPAgent, {
+        "cfg": config, "encoder": encoder, "rng": rng, "model": ModelFile(), "belief": belief, "counts": counts,
+        "memory": memory, "last": s.Optional(decision), "goal_obs": s.Optional(state)})
     done = s.Record(Done, {"agent": agent, "patience": count, "quiet": count, "seen": s.TupleOf(count, count),
                            "seen_all": count, "rule": s.Str(tuple(Done.RULES)), "loop_factor": count,
                            "pursuing": s.Bool()})

@@ -313,8 +313,8 @@ def write_run(out: Path, sim, agent: AIMAPPAgent, ep: Episode, metrics: dict, ti
 
     out.mkdir(parents=True, exist_ok=True)
     save(agent.model, out / "model")
-    if agent.anchors:  # views and scans that drift correction compares with (cogmap.agent.correction)
-        save_anchors(out / "anchors.npz", agent.anchors)
+    if agent.memory.anchors:  # views and scans that drift correction compares with (cogmap.agent.correction)
+        save_anchors(out / "anchors.npz", agent.memory.anchors)
     write_graphml(agent.model, out / "map.graphml")
     obs_dir = out / "observations"
     obs_dir.mkdir(exist_ok=True)

@@ -136,7 +136,7 @@ def load_agent(run: Path, seed: int = 0) -> tuple[AIMAPPAgent, dict]:
         raise ValueError(f"{run}: {len(encoder.images)} observation images for {model.num_obs[0]} model outcomes")
     agent = AIMAPPAgent(cfg, encoder=encoder, seed=seed, model=model)
     if (run / "anchors.npz").exists():
-        agent.anchors = load_anchors(run / "anchors.npz")
+        agent.memory.anchors.update(load_anchors(run / "anchors.npz"))
     return agent, manifest
 
 

@@ -56,12 +56,12 @@ def view_of(agent) -> dict[int, int]:
 def pair_similarity(agent) -> tuple[np.ndarray, np.ndarray]:
     """Distances (m) and panorama SSIM (as the encoder compares them, in the belief frame) of every
     pair of anchored states."""
-    states = sorted(agent.anchors)
+    states = sorted(agent.memory.anchors)
     d, s = [], []
     for i, a in enumerate(states):
         for b in states[i + 1:]:
             d.append(float(np.hypot(*(agent.poses[a] - agent.poses[b]))))
-            s.append(ssim(agent.anchors[a].panorama, agent.anchors[b].panorama))
+            s.append(ssim(agent.memory.anchors[a].panorama, agent.memory.anchors[b].panorama))
     return np.array(d), np.array(s)
 
 

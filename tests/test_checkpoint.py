@@ -115,13 +115,13 @@ def exploration_checkpoint(tmp_path_factory):
 
     def ctrl_c(self, decision):
         ended = real(self, decision)
-        if self.agent.step_count == 3:  # after the checkpoint of decision 2
+        if self.agent.counts.steps == 3:  # after the checkpoint of decision 2
             raise KeyboardInterrupt
         return ended
 
     with mock.patch.object(Done, "__call__", ctrl_c), pytest.raises(KeyboardInterrupt):
         explore("house", steps=20, seed=0, out=out, progress=False, patience=0, checkpoint_every=2)
-    assert load_checkpoint(out / "checkpoint")["agent"].step_count == 2
+    assert load_checkpoint(out / "checkpoint")["agent"].counts.steps == 2
     return out / "checkpoint"
 
 

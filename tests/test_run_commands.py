@@ -28,7 +28,7 @@ def _interrupted_run(out, steps=300, at=5, every=2):
 
     def ctrl_c(self, decision):
         ended = real(self, decision)
-        if self.agent.step_count == at:
+        if self.agent.counts.steps == at:
             raise KeyboardInterrupt
         return ended
 
@@ -105,7 +105,7 @@ def test_an_interrupted_exploration_resumed_from_its_checkpoint_ends_as_an_unint
 
     def ctrl_c_at_11(self, decision):
         ended = real(self, decision)
-        if self.agent.step_count == 11:
+        if self.agent.counts.steps == 11:
             raise KeyboardInterrupt
         return ended
 

@@ -36,63 +36,20 @@ import numpy as np
 
 from cogmap import inference
 from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseA, SparseB, compile
-from cogmap.genmodel.numerics import wrap_angle
 from cogmap.inference.learning import Event, learn_observation, learn_transition
-from cogmap.inference.se2 import SE2, apply, apply_pose, compose, invert, rotate
+from cogmap.inference.se2 import SE2, apply, apply_pose, invert
 
 from . import planner
 from .confidence import Confidence, assess, cusum
 from .config import AgentConfig
-from .correction import Anchor, relocalise, to_frame_panorama, track
+from .correction import Anchor
 from .encoder import Encoder, check_encoder, make_encoder
-from .mapping import centre_in_passage, direction, expansion_free_energies, reverse_heading
-from .sensing import blocked
-from .viewmap import ViewMap
+from .localisation import Belief, Counts, corrected_frame, empty_memory, found_frame, scan_agrees, shifted, to_belief
+from .map_growth import expand, move_obstacles, recognised, state_poses, visited_prior, waypoint
+from .mapping import direction, reverse_heading
+from .sensing import Sensed
 
-
-@dataclass
-class Sensed:
-    """What the robot reports at one step; ``None`` marks a stream that did not report.
-
-    The agent turns panorama, obstacle flags and scan into its belief frame before using them.
-
-    Attributes
-    ----------
-    panorama : numpy.ndarray or None
-        360-degree camera image, ``(H, W, 3)`` uint8 RGB (any image the encoder takes); None
-        while the camera is silent.
-    obstacles : numpy.ndarray or None
-        ``(num_headings,)`` bool, one per heading (odometry frame): an obstacle lies within the
-        move's corridor; None while the LiDAR is silent.
-    odometry : numpy.ndarray or None
-        ``(3,)`` float odometry pose ``(x, y, yaw)``, metres and radians; None while odometry is
-        silent.
-    moved : bool or None
-        Outcome of the last motion command (False: the controller reported it blocked); None when
-        no command was given.
-    scan : numpy.ndarray or None
-        ``(n, 2)`` float LiDAR returns relative to the robot, metres, axes of the odometry frame;
-        optional (None: no scan, only the obstacle flags).
-    sweep : numpy.ndarray or None
-        ``(beams, 2)`` float end point of every beam in beam order (a beam that returned nothing
-        ends at the LiDAR's range), relative to the robot, axes of the odometry frame: the area
-        the scan swept, for the agent's sensed grid; optional (None: the grid is drawn from the
-        returns' rays).
-    """
-
-    panorama: np.ndarray | None
-    obstacles: np.ndarray | None  # one bool per heading: obstacle within reach
-    odometry: np.ndarray | None  # (x, y, yaw) in the odometry frame
-    moved: bool | None = None  # outcome of the last motion command (None: no command)
-    scan: np.ndarray | None = None  # optional LiDAR returns relative to the robot (odometry frame, (n, 2))
-    sweep: np.ndarray | None = None  # optional end points of every beam (max range where nothing returned)
-    # the agent turns panorama, obstacles and scan into its belief frame before using them
-
-    @property
-    def missing(self) -> tuple[str, ...]:
-        """The streams that did not report: a subset of ("camera", "lidar", "odometry")."""
-        streams = (("camera", self.panorama), ("lidar", self.obstacles), ("odometry", self.odometry))
-        return tuple(name for name, value in streams if value is None)
+__all__ = ["AIMAPPAgent", "Decision", "Sensed", "initial_model"]
 
 
 @dataclass
@@ -172,7 +129,9 @@ def initial_model(cfg: AgentConfig, pose0) -> Model:
 
 
 class AIMAPPAgent:
-    """Owns the model, beliefs, pose correction, encoder and RNG; contains no maths.
+    """The AIMAPP agent: its config, encoder, RNG, model and a state of three records
+    (:class:`~cogmap.agent.localisation.Belief`, :class:`~cogmap.agent.localisation.Counts`,
+    :class:`~cogmap.agent.localisation.Memory`); the maths lives in the functions it calls.
 
     The model is created at the first :meth:`step` (one state at the first believed pose) unless
     one is given (a learnt model, e.g. for goal reaching).
@@ -196,27 +155,21 @@ class AIMAPPAgent:
         Image -> observation id.
     model : cogmap.genmodel.Model or None
         The generative model (None before the first step).
-    q : numpy.ndarray or None
-        ``(num_states,)`` posterior over states after the last step.
-    frame : cogmap.inference.se2.SE2
-        Odometry frame -> belief frame (drift correction, section 3.3).
-    anchors : dict of int to Anchor
-        State -> view and scan of its first confident visit (drift correction).
+    belief : Belief
+        Posterior, belief frame (``q`` and ``frame`` are also properties of the agent), lost test.
+    counts : Counts
+        Steps taken, accepted drift corrections, times lost, times found again.
+    memory : Memory
+        Anchors, states scanned from, moves driven, belief-frame moves, the sensed grid.
     last : Decision or None
         The last decision.
     goal_obs : int or None
         The preferred observation in goal mode (None: exploring).
-    lost : bool
-        The lost test fired and the agent is re-localising.
-    corrections, lost_events, relocalisations, step_count : int
-        Counters: accepted drift corrections, times lost, times found again, steps taken.
-    views : ViewMap
-        What the LiDAR has sensed (exploration planning).
 
     Raises
     ------
     KeyError
-        When ``config.encoder`` names no registered encoder.
+        When ``config.encoder`` names no registered encoder, or ``config.scheme`` no scheme.
     TypeError
         When the encoder does not follow the :class:`Encoder` protocol.
     """
@@ -231,28 +184,11 @@ class AIMAPPAgent:
             self._check_scheme(model)
         self.rng = np.random.default_rng(seed)
         self.model = model
-        self.q: np.ndarray | None = None
-        self.frame = SE2()  # odometry frame -> belief frame (drift correction, section 3.3)
-        self.anchors: dict[int, Anchor] = {}  # state -> view and scan of its first confident visit
-        self.corrections = 0  # accepted drift corrections
-        # every move of the belief frame: {"step", "kind", "moved_m"}, kind "correction" (_correct) or
-        # "relocalisation" (_update: found again after being lost, or a recognised view without LiDAR);
-        # moved_m = how far the believed position of the robot moved (m)
-        self.frame_moves: list[dict] = []
+        self.belief = Belief(None, SE2())
+        self.counts = Counts()
+        self.memory = empty_memory(self.cfg)
         self.last: Decision | None = None
         self.goal_obs: int | None = None
-        self.step_count = 0
-        self._outcome: bool | None = None  # reported outcome of the last real motion command
-        self.lost = False  # the confidence test fired: re-localising
-        self.lost_evidence = 0.0  # CUSUM statistic of conflict
-        self.lost_events = 0
-        self.last_obs: int | None = None
-        self.relocalisations = 0
-        self.views = ViewMap(self.cfg)  # what the LiDAR has sensed (exploration planning only)
-        self.scanned: set[int] = set()  # states the agent has stood on with its LiDAR reporting
-        # (state, heading, state) moves the robot has driven (and their reverses): their way is known
-        # passable, so only an obstacle within the robot's own width blocks them (_path_blocked)
-        self.traversed: set[tuple[int, int, int]] = set()
 
     # -- public ------------------------------------------------------------------------------
     @property
@@ -263,100 +199,54 @@ class AIMAPPAgent:
     @property
     def poses(self) -> np.ndarray:
         """``(num_states, 2)`` float stored state positions, metres, belief frame."""
-        return self.model.pose.poses[: self.num_states]
+        return state_poses(self.model)
 
     @property
-    def offset(self) -> np.ndarray:
-        """Translation part of the odometry -> belief transform."""
-        return self.frame.t
+    def q(self) -> np.ndarray | None:
+        """``(num_states,)`` posterior over states after the last step."""
+        return self.belief.q
+
+    @property
+    def frame(self) -> SE2:
+        """Odometry frame -> belief frame."""
+        return self.belief.frame
 
     def believed_pose(self, odometry) -> np.ndarray:
-        """Believed (x, y) of an odometry pose (``frame`` applied).
-
-        Parameters
-        ----------
-        odometry : array_like
-            Odometry pose ``(x, y[, yaw])``, metres; only x, y are read.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(2,)`` float position, metres, belief frame.
-        """
+        """Believed ``(2,)`` position (metres, belief frame) of an odometry pose ``(x, y[, yaw])``."""
         return apply(self.frame, np.asarray(odometry, dtype=float)[:2])
 
     def believed_pose_yaw(self, odometry) -> np.ndarray:
-        """Believed (x, y, yaw) of an odometry pose (x, y, yaw).
-
-        Parameters
-        ----------
-        odometry : array_like
-            ``(3,)`` odometry pose, metres and radians (a ``(2,)`` position gives a position).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(3,)`` float pose in the belief frame, yaw wrapped to [-pi, pi).
-        """
+        """Believed ``(3,)`` pose of an odometry pose ``(x, y, yaw)``, yaw wrapped to [-pi, pi)."""
         return apply_pose(self.frame, odometry)
 
     def to_odometry(self, xy) -> np.ndarray:
-        """A belief-frame point in the odometry frame (where the simulator drives).
-
-        Parameters
-        ----------
-        xy : array_like
-            ``(..., 2)`` points, metres, belief frame.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(..., 2)`` float points, metres, odometry frame.
-        """
+        """Belief-frame points ``(..., 2)`` in the odometry frame (where the simulator drives)."""
         return apply(invert(self.frame), xy)
-
-    def _shift_frame(self, delta) -> None:
-        """Translate the belief frame by ``delta`` (belief-frame metres)."""
-        self.frame = compose(SE2(0.0, float(delta[0]), float(delta[1])), self.frame)
 
     @property
     def at_goal(self) -> bool:
         """The last step confidently observed the goal observation."""
         last = self.last
-        return (self.goal_obs is not None and self.last_obs == self.goal_obs and last is not None
+        return (self.goal_obs is not None and self.belief.last_obs == self.goal_obs and last is not None
                 and last.confidence is not None and last.confidence.confident)
 
     def localise_at(self, odometry) -> int:
         """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``.
 
         The posterior becomes one-hot on that state, the belief frame is shifted so the believed
-        pose is the state's stored pose, and the last decision is forgotten.
-
-        Parameters
-        ----------
-        odometry : array_like
-            Current odometry pose ``(x, y[, yaw])``, metres.
-
-        Returns
-        -------
-        int
-            The state now believed.
+        pose is the state's stored pose, and the last decision is forgotten. Returns the state.
         """
         s, _ = self.model.pose_index().nearest(self.believed_pose(odometry))
-        self.q = np.zeros(self.num_states)
-        self.q[s] = 1.0
-        self._shift_frame(self.poses[s] - self.believed_pose(odometry))
-        self.last, self._outcome = None, None
+        q = np.zeros(self.num_states)
+        q[s] = 1.0
+        frame = shifted(self.frame, self.poses[s] - self.believed_pose(odometry))
+        self.belief = self.belief._replace(q=q, frame=frame, outcome=None)
+        self.last = None
         return s
 
     def set_goal(self, obs: int | None) -> None:
-        """Prefer observation ``obs`` (goal mode, section 4.4), or return to exploration with ``None``.
-
-        Parameters
-        ----------
-        obs : int or None
-            Observation id of the goal: C puts log-preference 1 on it (0 elsewhere), weighted by
-            ``cfg.goal_weight`` when planning. None clears the preference.
+        """Prefer observation ``obs`` (goal mode, section 4.4; C puts log-preference 1 on it, weighted
+        by ``cfg.goal_weight`` when planning), or return to exploration with ``None``.
 
         Raises
         ------
@@ -371,140 +261,89 @@ class AIMAPPAgent:
             self.model.C[0][obs] = 1.0
 
     def goal_states(self, min_prob: float = 0.5) -> np.ndarray:
-        """States whose observation model favours the goal observation.
-
-        Parameters
-        ----------
-        min_prob : float, optional
-            A state counts when ``A_o[goal, s]`` is at least this fraction of the largest entry
-            of that row (and at least 1e-9), default 0.5.
-
-        Returns
-        -------
-        numpy.ndarray
-            Int state indices, ascending; empty without a goal.
-        """
+        """States (ascending) whose ``A_o[goal, s]`` is at least ``min_prob`` of the row's largest
+        entry (and at least 1e-9); empty without a goal."""
         if self.goal_obs is None:
             return np.zeros(0, dtype=int)
         row = self.model.A_row(0, self.goal_obs)
         return np.flatnonzero(row >= max(min_prob * row.max(), 1e-9))
 
+    def scanned_from(self) -> np.ndarray:
+        """``(num_states,)`` bool: states the agent has stood on with its LiDAR reporting (what their
+        view can reveal has been seen; a state passed while the LiDAR was silent still promises it)."""
+        mask = np.zeros(self.num_states, dtype=bool)
+        mask[list(self.memory.scanned)] = True
+        return mask
+
+    def visited(self) -> np.ndarray:
+        """``(num_states,)`` bool: states whose A_o column's largest count exceeds ``2 * prior_count``."""
+        return self.model.A[0].taught(2 * self.cfg.prior_count)
+
     def step(self, sensed: Sensed) -> Decision:
         """One sense -> infer -> learn -> plan cycle (sections 3.1-3.6, see the module docstring).
 
-        Parameters
-        ----------
-        sensed : Sensed
-            What the robot reports now (odometry frame); ``moved`` is the outcome of the command
-            of the previous decision.
-
-        Returns
-        -------
-        Decision
-            Where to go next (waypoint in the odometry frame) and why; mode ``"paused"`` (stay,
-            nothing changed) while odometry is silent, or before the model exists while any
-            stream is.
+        ``sensed`` is what the robot reports now (odometry frame; ``moved`` is the outcome of the
+        previous decision's command). Returns where to go next (waypoint in the odometry frame) and
+        why; mode ``"paused"`` (stay, nothing changed) while odometry is silent, or before the
+        model exists while any stream is.
         """
-        self.step_count += 1
-        if self.last is not None and self._outcome is None and sensed.moved is not None:
-            self._outcome = bool(sensed.moved)  # outcome of the last real motion command
+        self.counts = self.counts._replace(steps=self.counts.steps + 1)
+        if self.last is not None and self.belief.outcome is None and sensed.moved is not None:
+            self.belief = self.belief._replace(outcome=bool(sensed.moved))  # of the last real motion command
         missing = sensed.missing
         if "odometry" in missing or (self.model is None and missing):
             return self._paused(sensed)  # nothing places the agent (or a first view is incomplete)
         pose = self.believed_pose(sensed.odometry)
         if self.model is None:
             self.model = self._check_scheme(initial_model(self.cfg, pose))
-            self.q = np.ones(1)
-        local = self._to_belief(sensed)
+            self.belief = self.belief._replace(q=np.ones(1))
+        local = to_belief(self.frame, self.cfg, sensed)
         obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
         q, conf = self._infer(obs, pose)
         if self._correct(q, conf, local, pose):  # a recognised place moved the belief frame
             self._record_frame_move("correction", pose, sensed.odometry)
             pose = self.believed_pose(sensed.odometry)
-            local = self._to_belief(sensed)
+            local = to_belief(self.frame, self.cfg, sensed)
         frame = self.frame
         expanded = self._update(q, conf, obs, local, pose, score)
         if self.frame is not frame:
             self._record_frame_move("relocalisation", pose, sensed.odometry)
-        self.views.blind = sensed.scan is None
-        if not self.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
-            self.views.observe(self, sensed)
+        views = self.memory.views
+        views.blind = sensed.scan is None
+        if not self.belief.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
+            views.observe(self, sensed)
             if conf.confident:
-                self.scanned.add(int(np.argmax(q)))
+                self.memory.scanned.add(int(np.argmax(self.q)))
         decision = self._decide(local, pose, conf, expanded)
         decision.missing = missing
-        self.last, self._outcome = decision, None
+        self.last = decision
+        self.belief = self.belief._replace(outcome=None)
         return decision
 
-    def _record_frame_move(self, kind: str, before, odometry) -> None:
-        """Note in :attr:`frame_moves` how far the belief frame's change moved the believed position."""
-        moved = float(np.hypot(*(self.believed_pose(odometry) - np.asarray(before)[:2])))
-        self.frame_moves.append({"step": self.step_count, "kind": kind, "moved_m": moved})
-
     # -- the cycle -------------------------------------------------------------------------
+    def _record_frame_move(self, kind: str, before, odometry) -> None:
+        moved = float(np.hypot(*(self.believed_pose(odometry) - np.asarray(before)[:2])))
+        self.memory.frame_moves.append({"step": self.counts.steps, "kind": kind, "moved_m": moved})
+
     def _paused(self, sensed: Sensed) -> Decision:
-        """Odometry is silent (or the very first view is incomplete): stay, change nothing,
-        resume when it returns."""
+        """Odometry is silent (or the very first view is incomplete): stay, change nothing."""
         state = -1 if self.last is None else self.last.state
         here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
         return Decision(self.cfg.stay, here, state, state, "paused", missing=sensed.missing)
 
-    def _to_belief(self, sensed: Sensed) -> Sensed:
-        """``sensed`` in the belief frame: panorama turned (images only), LiDAR returns rotated
-        and the per-heading obstacle flags recomputed from them (or, without a scan, taken from
-        the nearest odometry heading)."""
-        yaw = self.frame.yaw
-        if yaw == 0.0:
-            return sensed
-        cfg = self.cfg
-        pano = sensed.panorama
-        if pano is not None and np.ndim(pano) >= 2:
-            pano = to_frame_panorama(pano, yaw)
-        scan = None if sensed.scan is None else rotate(self.frame, sensed.scan)
-        sweep = None if sensed.sweep is None else rotate(self.frame, sensed.sweep)
-        if scan is not None:
-            h = 2 * np.pi * np.arange(cfg.num_headings) / cfg.num_headings
-            moves = cfg.influence_radius * np.stack([np.cos(h), np.sin(h)], axis=1)
-            obstacles = blocked(scan, moves, cfg.robot_radius + cfg.obstacle_margin)
-        elif sensed.obstacles is not None:
-            k = int(np.round(yaw * cfg.num_headings / (2 * np.pi)))
-            obstacles = np.roll(np.asarray(sensed.obstacles, dtype=bool), k)
-        else:  # the LiDAR is silent
-            obstacles = None
-        return Sensed(pano, obstacles, sensed.odometry, sensed.moved, scan, sweep)
-
     def _correct(self, q: np.ndarray, conf: Confidence, local: Sensed, pose: np.ndarray) -> bool:
-        """Drift correction (section 3.3): when the posterior confidently names a state that has
-        an anchor and the view and scan recognise it (``correction.relocalise``), the belief
-        frame is corrected by a rigid transform. Returns whether it was."""
-        cfg = self.cfg
-        if self.lost or not conf.confident or local.scan is None:
+        """Drift correction once per confident arrival (section 3.3); returns whether the frame moved."""
+        if self.belief.lost or not conf.confident or local.scan is None:
             return False
-        state = int(np.argmax(q))
-        last = self.last
+        state, last = int(np.argmax(q)), self.last
         if last is not None and last.state == state:
             return False  # compare once per arrival
-        reach = cfg.relocalise_max_correction * cfg.influence_radius
-        anchor = self.anchors.get(state)
-        if anchor is not None and np.ndim(local.panorama) >= 2:  # a revisit: the place's own view and scan
-            if np.hypot(*(pose - anchor.pose)) > cfg.influence_radius + reach:
-                return False
-            r = relocalise(anchor, np.asarray(local.panorama), local.scan, pose,
-                           max_shift=cfg.relocalise_max_shift, min_ssim=cfg.relocalise_align_ssim,
-                           min_inliers=cfg.relocalise_inliers, max_translation=reach)
-        elif anchor is None and cfg.track_anchors and last is not None and last.state in self.anchors:
-            # a first visit: the scan of the place just left is still in view
-            r = track(self.anchors[last.state], local.scan, pose, min_inliers=cfg.track_inliers,
-                      max_translation=cfg.track_max_correction * cfg.influence_radius)
-        else:
+        frame = corrected_frame(self.frame, self.memory.anchors, self.cfg, state,
+                                None if last is None else last.state, local, pose)
+        if frame is None:
             return False
-        if not r.accepted:
-            return False
-        moved = float(np.hypot(*(apply(r.correction, pose) - pose)))
-        if moved < cfg.min_correction and abs(r.correction.yaw) < cfg.min_correction_yaw:
-            return False  # within the alignment's own error: keep the frame
-        self.frame = compose(r.correction, self.frame)
-        self.corrections += 1
+        self.belief = self.belief._replace(frame=frame)
+        self.counts = self.counts._replace(corrections=self.counts.corrections + 1)
         return True
 
     def _check_scheme(self, model: Model) -> Model:
@@ -516,7 +355,7 @@ class AIMAPPAgent:
     def _observe(self, panorama) -> tuple[int, float]:
         """Observation id (a new id grows A_o) and the encoder's best similarity score."""
         obs, _ = self.encoder(panorama)
-        self.last_obs = obs
+        self.belief = self.belief._replace(last_obs=obs)
         while self.model.num_obs[0] <= obs:
             # a column's prior mass stays prior_count however many outcomes exist (SparseA), so a
             # taught column keeps its certainty as the vocabulary of views grows
@@ -526,69 +365,69 @@ class AIMAPPAgent:
     def _infer(self, obs: int | None, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
         """Posterior over states and the confidence test (section 3.3, A.1.2); ``obs`` is None
         while the camera is silent (the pose evidence alone then localises)."""
-        cfg = self.cfg
+        cfg, b = self.cfg, self.belief
         scheme = inference.get(cfg.scheme)  # the paper's exact filter by default (AgentConfig.scheme)
-        if self.lost:  # re-localising: odometry is not trusted, only what is seen
-            prior = self._visited_prior()
+        if b.lost:  # re-localising: odometry is not trusted, only what is seen
+            prior = visited_prior(self.model, cfg)
             q = [prior] if obs is None else scheme(self.model, [prior], [{"view": obs}])[0]
         else:  # B_s prediction combined with A_o and A_p evidence
-            prior = self._prior(self._outcome)
-            q, _ = scheme(self.model, [prior], [{"view": obs, "pose": pose}])
+            q, _ = scheme(self.model, [self._prior(b.outcome)], [{"view": obs, "pose": pose}])
         q = q[0]
         d2 = np.sum((self.poses - pose) ** 2, axis=1)
         near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are
         row = None if obs is None else self.model.A_row(0, obs)
-        conf = assess(q, near, row, cfg.z_threshold, self.lost_evidence, cfg.lost_slack)
-        return q, conf
+        return q, assess(q, near, row, cfg.z_threshold, b.lost_evidence, cfg.lost_slack)
 
     def _update(self, q: np.ndarray, conf: Confidence, obs: int | None, sensed: Sensed, pose: np.ndarray,
                 score: float) -> int:
         """Lost/found bookkeeping and learning; returns how many states the map gained."""
-        cfg = self.cfg
+        cfg, b, counts, anchors = self.cfg, self.belief, self.counts, self.memory.anchors
         state = int(np.argmax(q))
         expanded = 0
-        if not self.lost and conf.conflict > cfg.lost_slack and self._scan_agrees(sensed, pose):
+        if not b.lost and conf.conflict > cfg.lost_slack and scan_agrees(anchors, self.poses, cfg, sensed.scan, pose):
             # the view points elsewhere but the LiDAR matches the place the belief is at: aliasing
             # (repeated racks, similar rooms), not a wrong position; it adds no evidence of being lost
-            evidence = cusum(self.lost_evidence, 0.0, cfg.lost_slack)
+            evidence = cusum(b.lost_evidence, 0.0, cfg.lost_slack)
             conf = conf._replace(conflict=0.0, lost_evidence=evidence, confident=conf.dominance >= cfg.z_threshold)
-        if self.lost:
+        if b.lost:
             # a familiar view singles out a place (and, with a LiDAR, the scan confirms it)
-            if obs is not None and q[state] >= 0.5 and self._recognised(state, obs) and self._found_at(
-                    state, sensed, pose):
-                self.lost, self.lost_evidence = False, 0.0
-                self.relocalisations += 1
+            if obs is not None and q[state] >= 0.5 and recognised(self.model, cfg, state, obs):
+                frame = found_frame(b.frame, anchors.get(state), cfg, self.poses[state], sensed, pose)
+                if frame is not None:
+                    self.belief = b._replace(frame=frame, lost=False, lost_evidence=0.0)
+                    self.counts = counts._replace(relocalisations=counts.relocalisations + 1)
         elif conf.lost(cfg.z_threshold):
-            self.lost, self.lost_evidence = True, 0.0
-            self.lost_events += 1
-            q = self._visited_prior()
+            self.belief = b._replace(lost=True, lost_evidence=0.0)
+            self.counts = counts._replace(lost_events=counts.lost_events + 1)
+            q = visited_prior(self.model, cfg)
         else:
-            self.lost_evidence = conf.lost_evidence
+            self.belief = b._replace(lost_evidence=conf.lost_evidence)
             if conf.confident:
                 expanded = self._learn(state, obs, sensed, pose, score)
             elif obs is not None:  # unsure between nearby states: learn A_o under the posterior (Eq. 8)
                 learn_observation(self.model, 0, obs, [q], lr=cfg.obs_learning_rate)
-        self.q = np.zeros(self.num_states)
-        self.q[: q.size] = q
+        full = np.zeros(self.num_states)
+        full[: q.size] = q
+        self.belief = self.belief._replace(q=full)
         return expanded
 
     def _decide(self, sensed: Sensed, pose: np.ndarray, conf: Confidence, expanded: int) -> Decision:
         cfg = self.cfg
         state = int(np.argmax(self.q))
-        if self.lost:
+        if self.belief.lost:
             # The map position is unknown, so the graph cannot guide a move: step in a free
             # direction of the real surroundings until a familiar view is recognised.
             if sensed.obstacles is None:  # nothing says which way is free: wait for the LiDAR
                 return Decision(cfg.stay, self.to_odometry(pose), state, state, "relocalise", conf, expanded)
             free = np.flatnonzero(~np.asarray(sensed.obstacles, dtype=bool))
             action = int(self.rng.choice(free)) if free.size else cfg.stay
-            waypoint = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
-            return Decision(action, self.to_odometry(waypoint), state, state, "relocalise", conf, expanded)
+            to = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
+            return Decision(action, self.to_odometry(to), state, state, "relocalise", conf, expanded)
         mode = "goal" if self.goal_obs is not None else "explore"
-        flags = self._move_obstacles(state, sensed.obstacles, sensed.scan, pose)
+        flags = move_obstacles(self.model, cfg, self.memory.traversed, state, sensed.obstacles, sensed.scan, pose)
         action, efe = planner.decide(self, state, flags, mode)
-        target, waypoint = self._waypoint(state, action)
-        return Decision(action, self.to_odometry(waypoint), state, target, mode, conf, expanded, efe)
+        target, to = waypoint(self.model, cfg, state, action)
+        return Decision(action, self.to_odometry(to), state, target, mode, conf, expanded, efe)
 
     # -- pieces ------------------------------------------------------------------------------
     def _prior(self, moved: bool | None) -> np.ndarray:
@@ -596,8 +435,7 @@ class AIMAPPAgent:
 
         A move the controller reported blocked is learnt first (experienced impossible, Table 7)
         and predicts no change of state."""
-        n = self.num_states
-        q = np.zeros(n)
+        q = np.zeros(self.num_states)
         q[: self.q.size] = self.q
         last = self.last
         if last is None or last.action == self.cfg.stay:
@@ -612,207 +450,26 @@ class AIMAPPAgent:
     def _reverse(self, action: int) -> int | None:
         return reverse_heading(action, self.cfg.num_headings) if action != self.cfg.stay else None
 
-    def scanned_from(self) -> np.ndarray:
-        """Mask of states the agent has stood on with its LiDAR reporting: what their view can
-        reveal has been seen (a state passed while the LiDAR was silent still promises it).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(num_states,)`` bool.
-        """
-        mask = np.zeros(self.num_states, dtype=bool)
-        mask[list(self.scanned)] = True
-        return mask
-
-    def visited(self) -> np.ndarray:
-        """Mask of states whose observation model has been taught (the agent has been there).
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(num_states,)`` bool: the largest count of the state's A_o column exceeds
-            ``2 * prior_count``.
-        """
-        return self.model.A[0].taught(2 * self.cfg.prior_count)
-
-    def _scan_agrees(self, sensed: Sensed, pose: np.ndarray) -> bool:
-        """The LiDAR scan aligns, within the tracking gate, with the anchor of the nearest
-        anchored state around the believed pose (False without a scan or an anchor nearby)."""
-        cfg = self.cfg
-        if sensed.scan is None or not self.anchors:
-            return False
-        states = np.fromiter(self.anchors, dtype=int)
-        d = np.hypot(*(self.poses[states] - pose).T)
-        k = int(np.argmin(d))
-        if d[k] > 1.5 * cfg.influence_radius:
-            return False
-        r = track(self.anchors[int(states[k])], sensed.scan, pose, min_inliers=cfg.relocalise_inliers,
-                  max_translation=cfg.track_max_correction * cfg.influence_radius)
-        return r.accepted
-
-    def _found_at(self, state: int, sensed: Sensed, pose: np.ndarray) -> bool:
-        """Re-localise on ``state`` after being lost; returns whether the belief frame moved.
-        With the state's anchor and a scan, the view (heading) and the scan (position) must
-        align with it, as in :func:`correction.relocalise` from the anchor's pose; otherwise the
-        belief moves onto the state's stored pose."""
-        cfg = self.cfg
-        anchor = self.anchors.get(state)
-        if anchor is None or sensed.scan is None or np.ndim(sensed.panorama) < 2:
-            self._shift_frame(self.poses[state] - pose)  # trust the map's pose
-            return True
-        r = relocalise(anchor, np.asarray(sensed.panorama), sensed.scan, anchor.pose,
-                       max_shift=cfg.relocalise_max_shift, min_ssim=cfg.relocalise_align_ssim,
-                       min_inliers=cfg.relocalise_inliers, max_translation=cfg.influence_radius)
-        if not r.accepted:
-            return False
-        # move the believed pose onto the anchor's, then apply the alignment found from there
-        self.frame = compose(compose(r.correction, SE2(0.0, *(anchor.pose - pose))), self.frame)
-        return True
-
-    def _recognised(self, state: int, obs: int) -> bool:
-        """``obs`` has been tied to ``state`` before and to no other state as strongly."""
-        m = self.model
-        counts = m.pA_row(0, obs)
-        return counts[state] > 2 * self.cfg.prior_count and counts.argmax() == state
-
-    def _visited_prior(self) -> np.ndarray:
-        visited = self.visited()
-        return visited / visited.sum() if visited.any() else np.full(self.num_states, 1.0 / self.num_states)
-
     def _learn(self, state: int, obs: int | None, sensed: Sensed, pose: np.ndarray, score: float) -> int:
-        m, cfg = self.model, self.cfg
+        m, cfg, anchors = self.model, self.cfg, self.memory.anchors
         if obs is not None:
             onehot = np.zeros(self.num_states)
             onehot[state] = 1.0
-            if sensed.scan is None and self._recognised(state, obs) and score >= cfg.relocalise_ssim:
+            if sensed.scan is None and recognised(m, cfg, state, obs) and score >= cfg.relocalise_ssim:
                 # no LiDAR to align: a familiar, nearly identical view re-localises onto the state's pose
-                self._shift_frame(self.poses[state] - pose)
-            elif state not in self.anchors and sensed.scan is not None and np.ndim(sensed.panorama) >= 2:
-                self.anchors[state] = Anchor(pose.copy(), np.asarray(sensed.panorama).copy(), sensed.scan.copy(),
-                                             self.step_count)
+                self.belief = self.belief._replace(frame=shifted(self.frame, self.poses[state] - pose))
+            elif state not in anchors and sensed.scan is not None and np.ndim(sensed.panorama) >= 2:
+                anchors[state] = Anchor(pose.copy(), np.asarray(sensed.panorama).copy(), sensed.scan.copy(),
+                                        self.counts.steps)
             learn_observation(m, 0, obs, [onehot], lr=cfg.obs_learning_rate)
         last = self.last
         arrived = last is None or state != last.state
-        if last is not None and self._outcome and state != last.state and last.action != cfg.stay:
+        if last is not None and self.belief.outcome and state != last.state and last.action != cfg.stay:
             learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
                              reverse_control=self._reverse(last.action), rates=cfg.learning)
-            self.traversed.add((int(last.state), int(last.action), state))
-            self.traversed.add((state, int(self._reverse(last.action)), int(last.state)))
+            self.memory.traversed.add((int(last.state), int(last.action), state))
+            self.memory.traversed.add((state, int(self._reverse(last.action)), int(last.state)))
         if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
             return 0
-        return self._expand(state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan, pose)
-
-    def _neighbours_by_heading(self, state: int) -> np.ndarray:
-        """For each heading, the nearest state lying in that direction (bearing within half a
-        heading sector, at most 1.5 influence radii away), or -1."""
-        cfg = self.cfg
-        idx, dist = self.model.pose_index().near(self.poses[state], 1.5 * cfg.influence_radius)
-        keep = dist > 1e-9
-        idx, dist = idx[keep], dist[keep]
-        rel = self.poses[idx] - self.poses[state]
-        bearing = np.arctan2(rel[:, 1], rel[:, 0])
-        sector = np.pi / cfg.num_headings
-        out = np.full(cfg.num_headings, -1)
-        for h in range(cfg.num_headings):
-            off = np.abs(wrap_angle(bearing - 2 * np.pi * h / cfg.num_headings))
-            ok = off <= sector + 1e-9
-            if ok.any():
-                out[h] = int(idx[ok][np.argmin(dist[ok])])  # ties: the lowest index, as before
-        return out
-
-    def _path_blocked(self, heading: int, target: int, obstacles: np.ndarray, scan: np.ndarray | None,
-                      pose: np.ndarray, state: int | None = None) -> bool:
-        """Would the move toward ``target`` collide? With a scan, its corridor is checked along
-        the actual bearing and length from ``pose`` to the target (what the robot will drive);
-        otherwise the heading's flag is used. The corridor is the robot's width plus
-        ``obstacle_margin``, except for a move from ``state`` the robot has driven before (either
-        way, :attr:`traversed`): a return within the margin alone does not block a way known
-        passable (else a doorway passed near its jamb would cut the map in two), while anything
-        within the robot's own width (e.g. a box moved onto the way) still does."""
-        if scan is None:
-            return bool(obstacles[heading])
-        cfg = self.cfg
-        move = self.poses[target] - pose
-        if not blocked(scan, move, cfg.robot_radius + cfg.obstacle_margin)[0]:
-            return False
-        if state is not None and (int(state), int(heading), int(target)) in self.traversed:
-            return bool(blocked(scan, move, cfg.robot_radius)[0])
-        return True
-
-    def _move_obstacles(self, state: int, obstacles: np.ndarray | None, scan: np.ndarray | None,
-                        pose: np.ndarray) -> np.ndarray:
-        """Collision flag per heading for the move the agent would make: toward the believed
-        successor when there is one, else straight along the heading. Without the LiDAR only
-        moves along known transitions are offered."""
-        if obstacles is None:
-            return np.array([self._waypoint(state, h)[0] == state for h in range(self.cfg.num_headings)])
-        flags = np.asarray(obstacles, dtype=bool).copy()
-        if scan is None:
-            return flags
-        for h in range(self.cfg.num_headings):
-            target, _ = self._waypoint(state, h)
-            if target != state:
-                flags[h] = self._path_blocked(h, target, obstacles, scan, pose, state)
-        return flags
-
-    def _expand(self, state: int, obstacles: np.ndarray, scan: np.ndarray | None, pose: np.ndarray) -> int:
-        """Predicted transitions from the obstacle signal, and Eq. (7) map expansion in free
-        directions where no state lies yet."""
-        m, cfg = self.model, self.cfg
-        radius = cfg.node_spacing * cfg.influence_radius
-        origin = self.poses[state].copy()
-        neighbours = self._neighbours_by_heading(state)
-        created = 0
-        B = m.B[0]
-        for h in range(cfg.num_headings):
-            rev = reverse_heading(h, cfg.num_headings)
-            n = int(neighbours[h])
-            believed = {int(t) for t, p in zip(B.succ[state, h], B.prob[state, h], strict=True) if p > 0}
-            for t in sorted((believed | {n}) - {state, -1}):  # states this move is believed to reach
-                free = not self._path_blocked(h, t, obstacles, scan, pose, state)
-                event = Event.PREDICTED_POSSIBLE if free and t == n else Event.PREDICTED_IMPOSSIBLE
-                if free and t != n:
-                    continue  # another state now lies in that direction: leave this link alone
-                learn_transition(m, 0, state, h, t, event, reverse_control=rev, rates=cfg.learning)
-            if obstacles[h] or n >= 0:
-                continue
-            if created >= cfg.lookahead_nodes:
-                continue
-            p_star = self._predicted_pose(origin, h, scan, pose)
-            d_near = self.model.pose_index().nearest(p_star)[1]
-            if expansion_free_energies(np.array([d_near]), radius, cfg.sigma)[0] < 0:  # Eq. (7)
-                new = m.add_state(0, pose=p_star, obs_count=cfg.prior_count / m.num_obs[0])
-                created += 1
-                learn_transition(m, 0, state, h, new, Event.PREDICTED_POSSIBLE, reverse_control=rev,
-                                 rates=cfg.learning)
-        return created
-
-    def _predicted_pose(self, origin: np.ndarray, heading: int, scan: np.ndarray | None,
-                        pose: np.ndarray) -> np.ndarray:
-        """Where a move along ``heading`` from the state at ``origin`` is predicted to lead: one
-        influence radius along it, moved to the centre line of a corridor narrower than
-        ``passage_width`` when the LiDAR shows one (and the move there is as free)."""
-        cfg = self.cfg
-        u = direction(heading, cfg.num_headings)
-        p_star = origin + cfg.influence_radius * u
-        if scan is None or cfg.passage_width <= 0:
-            return p_star
-        centred = centre_in_passage(p_star, u, pose + scan, cfg.passage_width, max_shift=0.5 * cfg.influence_radius)
-        if blocked(scan, centred - pose, cfg.robot_radius + cfg.obstacle_margin)[0]:
-            return p_star
-        return centred
-
-    def _waypoint(self, state: int, action: int) -> tuple[int, np.ndarray]:
-        """Where an action leads: its most probable successor other than staying (as the planner
-        saw it), or, for a direction with no state yet, one step along its heading."""
-        cfg = self.cfg
-        if action == cfg.stay:
-            return state, self.poses[state].copy()
-        B = self.model.B[0]
-        prob = np.where(B.succ[state, action] != state, B.prob[state, action], 0.0)
-        k = int(np.argmax(prob))
-        if prob[k] > 0:
-            target = int(B.succ[state, action, k])
-            return target, self.poses[target].copy()
-        return state, self.poses[state] + cfg.influence_radius * direction(action, cfg.num_headings)
+        return expand(m, cfg, self.memory.traversed, state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan,
+                      pose)

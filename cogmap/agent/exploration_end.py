@@ -66,11 +66,11 @@ class Done:
             return False
         self.quiet = self.quiet + 1 if seen == self.seen else 0
         self.seen = seen
-        sensing = decision.mode == "explore" and a.cfg.view_weighting and a.views.grid is not None
-        nothing_left = sensing and a.views.target < 0
+        sensing = decision.mode == "explore" and a.cfg.view_weighting and a.memory.views.grid is not None
+        nothing_left = sensing and a.memory.views.target < 0
         if getattr(self, "rule", "seen-all") == "liveness":
-            nothing_left = nothing_left and getattr(a.views, "unreached", 0) == 0
-        self.pursuing = bool(sensing and a.views.target >= 0)
+            nothing_left = nothing_left and getattr(a.memory.views, "unreached", 0) == 0
+        self.pursuing = bool(sensing and a.memory.views.target >= 0)
         self.seen_all = self.seen_all + 1 if nothing_left else 0
         return self.finished
 

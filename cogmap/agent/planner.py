@@ -27,7 +27,7 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     nothing is set aside while the LiDAR is silent, since the map cannot grow then), as the oracle's viewpoints
     are once stood on. Empty when no viewpoint is left or none is brought nearer; then
     ``views.unreached`` counts the viewpoints and the paper's terms alone decide."""
-    cfg, views, B, n = agent.cfg, agent.views, agent.model.B[0], agent.num_states
+    cfg, views, B, n = agent.cfg, agent.memory.views, agent.model.B[0], agent.num_states
     poses, visited = agent.poses[:n], agent.scanned_from()[:n].astype(bool)
     xy, gains = views.viewpoints(poses, visited, areas)
     src, dst = B.edges(cfg.inductive_threshold, n)
@@ -94,7 +94,7 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
         goal_states = agent.goal_states()
     else:
         objective, goal_states = efe.exploration(), None
-        views, seen_from = agent.views, agent.scanned_from()
+        views, seen_from = agent.memory.views, agent.scanned_from()
         areas = views.areas(agent.poses, seen_from) if cfg.view_weighting else None
         if areas is not None:  # what the LiDAR has sensed weights the information gain; informative views pull
             goal_states = _target(agent, state, areas)

@@ -1,4 +1,5 @@
-"""Binary obstacle signal per action direction from a 2-D LiDAR scan.
+"""What the robot reports at one step (:class:`Sensed`), and the binary obstacle signal per action
+direction from a 2-D LiDAR scan.
 
 A heading is blocked when any LiDAR return falls inside the corridor the robot would sweep
 moving one step along it: a rectangle of half-width ``robot radius + margin`` and length
@@ -8,6 +9,8 @@ that pass an obstacle.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -44,3 +47,48 @@ def corridor_obstacles(ranges: np.ndarray, beam_angles: np.ndarray, num_headings
     h = 2 * np.pi * np.arange(num_headings) / num_headings
     moves = step * np.stack([np.cos(h), np.sin(h)], axis=1)
     return blocked(scan_points(ranges, beam_angles, max_range), moves, half_width)
+
+
+@dataclass
+class Sensed:
+    """What the robot reports at one step; ``None`` marks a stream that did not report.
+
+    The agent turns panorama, obstacle flags and scan into its belief frame before using them.
+
+    Attributes
+    ----------
+    panorama : numpy.ndarray or None
+        360-degree camera image, ``(H, W, 3)`` uint8 RGB (any image the encoder takes); None
+        while the camera is silent.
+    obstacles : numpy.ndarray or None
+        ``(num_headings,)`` bool, one per heading (odometry frame): an obstacle lies within the
+        move's corridor; None while the LiDAR is silent.
+    odometry : numpy.ndarray or None
+        ``(3,)`` float odometry pose ``(x, y, yaw)``, metres and radians; None while odometry is
+        silent.
+    moved : bool or None
+        Outcome of the last motion command (False: the controller reported it blocked); None when
+        no command was given.
+    scan : numpy.ndarray or None
+        ``(n, 2)`` float LiDAR returns relative to the robot, metres, axes of the odometry frame;
+        optional (None: no scan, only the obstacle flags).
+    sweep : numpy.ndarray or None
+        ``(beams, 2)`` float end point of every beam in beam order (a beam that returned nothing
+        ends at the LiDAR's range), relative to the robot, axes of the odometry frame: the area
+        the scan swept, for the agent's sensed grid; optional (None: the grid is drawn from the
+        returns' rays).
+    """
+
+    panorama: np.ndarray | None
+    obstacles: np.ndarray | None  # one bool per heading: obstacle within reach
+    odometry: np.ndarray | None  # (x, y, yaw) in the odometry frame
+    moved: bool | None = None  # outcome of the last motion command (None: no command)
+    scan: np.ndarray | None = None  # optional LiDAR returns relative to the robot (odometry frame, (n, 2))
+    sweep: np.ndarray | None = None  # optional end points of every beam (max range where nothing returned)
+    # the agent turns panorama, obstacles and scan into its belief frame before using them
+
+    @property
+    def missing(self) -> tuple[str, ...]:
+        """The streams that did not report: a subset of ("camera", "lidar", "odometry")."""
+        streams = (("camera", self.panorama), ("lidar", self.obstacles), ("odometry", self.odometry))
+        return tuple(name for name, value in streams if value is None)

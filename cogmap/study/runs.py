@@ -372,13 +372,13 @@ def run_scaling(spec) -> dict:
         sizes = []
 
         def on_step(_d):
-            if agent.step_count % every == 0:
-                sizes.append({"step": agent.step_count, "num_states": agent.num_states,
+            if agent.counts.steps % every == 0:
+                sizes.append({"step": agent.counts.steps, "num_states": agent.num_states,
                               "num_observations": int(agent.model.num_obs[0]),
                               "model_bytes": model_size_bytes(agent.model)})
 
         ep = run_agent(sim, agent, spec["steps"], progress=False, on_step=on_step)
-        sizes.append({"step": agent.step_count, "num_states": agent.num_states,
+        sizes.append({"step": agent.counts.steps, "num_states": agent.num_states,
                       "num_observations": int(agent.model.num_obs[0]), "model_bytes": model_size_bytes(agent.model)})
         return {"num_states": [int(v) for v in ep.num_states], "decision_ms": [round(v, 3) for v in ep.decision_ms],
                 "sizes": sizes, "coverage": float(ep.coverage[-1]), **_identity(sim, ep)}

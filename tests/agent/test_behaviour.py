@@ -29,7 +29,7 @@ def belief_error(agent, w):
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_lost_test_quiet_in_normal_operation_fires_when_kidnapped_and_recovers(seed):
     w, agent, decisions, moved = explored(seed)
-    assert agent.lost_events == 0  # does not fire in normal operation
+    assert agent.counts.lost_events == 0  # does not fire in normal operation
     assert all(d.mode == "explore" for d in decisions)
     assert agent.num_states > 15
     visited = agent.poses[agent.model.live_pA(0).max(axis=0) > 2 * agent.cfg.prior_count]
@@ -39,7 +39,7 @@ def test_lost_test_quiet_in_normal_operation_fires_when_kidnapped_and_recovers(s
     after, _ = run(w, agent, 20, moved)
     first_lost = next(i for i, d in enumerate(after) if d.mode == "relocalise")
     assert first_lost <= 3
-    assert agent.relocalisations >= 1  # found again by what it sees
+    assert agent.counts.relocalisations >= 1  # found again by what it sees
     assert after[-1].mode == "explore"
     assert belief_error(agent, w) < 0.6
 
@@ -48,11 +48,11 @@ def test_relocalisation_corrects_an_odometry_jump():
     w, agent, _, moved = explored(0, steps=40)
     assert belief_error(agent, w) < 0.05
     w.odometry_jump((0.6, 0.0))  # wheel slip: odometry is now 0.6 m off
-    offset = agent.offset.copy()
+    offset = agent.frame.t.copy()
     assert belief_error(agent, w) > 0.55
     errors = []
     run(w, agent, 15, moved, on_step=lambda d: errors.append(belief_error(agent, w)))
-    assert np.hypot(*(agent.offset - offset)) > 0.5  # the correction moved the belief frame
+    assert np.hypot(*(agent.frame.t - offset)) > 0.5  # the correction moved the belief frame
     assert min(errors) < 0.1  # a recognised place put the belief back on the map
     assert errors[-1] < 0.1
 
@@ -68,7 +68,7 @@ def test_sensor_dropout_pauses_and_resumes_without_reinitialising():
     np.testing.assert_array_equal(agent.q, q)
     resumed, _ = run(w, agent, 10, moved)
     assert all(d.mode == "explore" for d in resumed)
-    assert agent.lost_events == 0
+    assert agent.counts.lost_events == 0
     assert belief_error(agent, w) < 0.05
 
 

@@ -61,9 +61,10 @@ def test_fit_and_icp_recover_a_known_rotation():
 def test_agent_belief_frame_turns_poses_waypoints_scan_obstacles_and_panorama():
     from cogmap.agent.aimapp import AIMAPPAgent, Sensed
     from cogmap.agent.config import AgentConfig
+    from cogmap.agent.localisation import to_belief
 
     agent = AIMAPPAgent(AgentConfig())
-    agent.frame = SE2(np.pi / 2, 1.0, 2.0)
+    agent.belief = agent.belief._replace(frame=SE2(np.pi / 2, 1.0, 2.0))
     odom = np.array([3.0, -1.0, 0.2])
     np.testing.assert_allclose(agent.believed_pose(odom), [2.0, 5.0], atol=1e-12)  # R(90) (3, -1) + (1, 2)
     np.testing.assert_allclose(agent.believed_pose_yaw(odom)[2], 0.2 + np.pi / 2)
@@ -72,11 +73,12 @@ def test_agent_belief_frame_turns_poses_waypoints_scan_obstacles_and_panorama():
     flags = np.zeros(12, dtype=bool)
     flags[0] = True
     pano = np.arange(64 * 256).reshape(64, 256)
-    local = agent._to_belief(Sensed(pano, flags, odom, None, np.array([[0.8, 0.0]])))
+    local = to_belief(agent.frame, agent.cfg, Sensed(pano, flags, odom, None, np.array([[0.8, 0.0]])))
     np.testing.assert_allclose(local.scan, [[0.0, 0.8]], atol=1e-12)
     assert np.flatnonzero(local.obstacles).tolist() == [3]
     np.testing.assert_array_equal(local.panorama, np.roll(pano, -64, axis=1))  # a quarter turn = 64 columns
-    assert np.flatnonzero(agent._to_belief(Sensed(pano, flags, odom)).obstacles).tolist() == [3]  # no scan
+    no_scan = to_belief(agent.frame, agent.cfg, Sensed(pano, flags, odom))
+    assert np.flatnonzero(no_scan.obstacles).tolist() == [3]
 
 
 def test_anchors_round_trip_through_npz(tmp_path):
@@ -159,10 +161,10 @@ def test_severe_drift_belief_stays_closer_to_the_truth_than_odometry():
 
     noise = OdometryNoise(slip=0.08, heading_bias=0.05)  # the drift study's severe level
     agent, err_b, err_o = _drift_run("aisle_warehouse", 1, 60, noise)
-    assert agent.corrections >= 10
+    assert agent.counts.corrections >= 10
     # every accepted correction is on record with how far it moved the believed position
-    moves = [m for m in agent.frame_moves if m["kind"] == "correction"]
-    assert len(moves) == agent.corrections and all(0.0 < m["moved_m"] < 2.0 for m in moves)
+    moves = [m for m in agent.memory.frame_moves if m["kind"] == "correction"]
+    assert len(moves) == agent.counts.corrections and all(0.0 < m["moved_m"] < 2.0 for m in moves)
     assert err_o[-1] > 2.0  # the odometry has drifted by metres
     assert err_b[-1] < 0.25 * err_o[-1]
     assert np.sqrt(np.mean(err_b**2)) < 0.25 * np.sqrt(np.mean(err_o**2))
@@ -178,7 +180,7 @@ def test_revisits_alone_correct_moderate_drift_in_the_small_warehouse():
 
     noise = OdometryNoise(slip=0.03, heading_bias=0.02)  # the drift study's moderate level
     agent, err_b, err_o = _drift_run("small_warehouse", 0, 60, noise, track_anchors=False)
-    assert agent.corrections >= 5  # places recognised by view and scan
+    assert agent.counts.corrections >= 5  # places recognised by view and scan
     assert np.sqrt(np.mean(err_b**2)) < 0.6 * np.sqrt(np.mean(err_o**2))
     assert err_b[-1] < 0.5 * err_o[-1]
 
@@ -195,8 +197,8 @@ def test_explore_command_line_drift_flags_are_recorded(tmp_path, capsys):
     from cogmap.goal import load_agent
 
     agent, _ = load_agent(out)  # the places' anchors come back with the model
-    assert agent.anchors and max(agent.anchors) < agent.num_states
-    for a in agent.anchors.values():
+    assert agent.memory.anchors and max(agent.memory.anchors) < agent.num_states
+    for a in agent.memory.anchors.values():
         assert a.pose.shape == (2,) and a.scan.ndim == 2 and a.scan.shape[1] == 2 and a.panorama.ndim == 3
     # a goal run in the same drifting conditions, with the loaded anchors
     capsys.readouterr()

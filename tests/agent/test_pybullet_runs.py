@@ -60,7 +60,7 @@ def test_camera_dropout_keeps_moving_and_mapping_on_odometry_and_lidar():
         assert all(not d.missing for d in decisions[:6] + decisions[12:])
         assert "paused" not in [d.mode for d in decisions]
         assert sum(d.action != cfg.stay for d in silent) >= 4  # it keeps exploring without the camera
-        assert agent.lost_events == 0
+        assert agent.counts.lost_events == 0
         assert np.hypot(*(agent.believed_pose(sim.odometry()) - sim.true_pose()[:2])) < 0.05
     finally:
         sim.close()
@@ -129,7 +129,7 @@ def _goal_run(env, seed, explore_steps, noise=None):
         goal_state = _farthest_visited(agent, agent.believed_pose(sim.odometry()))
         goal_obs = int(agent.model.live_A(0)[:, goal_state].argmax())
         _, summary = pursue(sim, agent, goal_obs, 80, progress=False)
-        return ep.coverage[-1], agent.lost_events, summary
+        return ep.coverage[-1], agent.counts.lost_events, summary
     finally:
         sim.close()
 
@@ -156,14 +156,14 @@ def test_kidnapped_robot_is_noticed_and_found_again():
     for seed in range(2):
         sim, agent, _ = _explored("mini_warehouse", seed, 60)
         try:
-            assert agent.lost_events == 0
+            assert agent.counts.lost_events == 0
             far = _farthest_visited(agent, sim.true_pose()[:2])
             assert np.hypot(*(agent.poses[far] - sim.true_pose()[:2])) > 3.0
             sim.teleport((*agent.poses[far], sim.true_pose()[2]))  # odometry does not notice
             modes: list[str] = []
             run_agent(sim, agent, 20, progress=False, on_step=lambda d, out=modes: out.append(d.mode))
-            assert "relocalise" in modes[:3] and agent.lost_events == 1
-            assert agent.relocalisations == 1 and modes[-1] == "explore"
+            assert "relocalise" in modes[:3] and agent.counts.lost_events == 1
+            assert agent.counts.relocalisations == 1 and modes[-1] == "explore"
             assert np.hypot(*(agent.believed_pose(sim.odometry()) - sim.true_pose()[:2])) < 1.2
         finally:
             sim.close()
@@ -211,7 +211,7 @@ def test_aliased_racks_do_not_make_the_agent_lost_with_exact_odometry():
     # the place the belief is at, now marks the conflict as aliasing.
     sim, agent, episode = _explored("large_warehouse", 0, 70)
     try:
-        assert agent.lost_events == 0
+        assert agent.counts.lost_events == 0
         errors = [np.hypot(r["belief_x"] - r["true_x"], r["belief_y"] - r["true_y"]) for r in episode.rows]
         assert max(errors) < 0.2
     finally:

@@ -16,6 +16,6 @@ def test_no_belief_jump_with_perfect_odometry(env, seed):
     finally:
         sim.close()
     assert len(ep.rows) >= 10  # the run explored (its own end may come before the budget)
-    assert all(m["moved_m"] <= 1.0 for m in agent.frame_moves), agent.frame_moves
+    assert all(m["moved_m"] <= 1.0 for m in agent.memory.frame_moves), agent.memory.frame_moves
     # and the belief stays on the truth (perfect odometry: any gap would come from the frame moves)
     assert max(abs(b[0] - t[0]) + abs(b[1] - t[1]) for b, t in zip(belief, truth, strict=True)) <= 1.0
