@@ -45,8 +45,17 @@ from .config import AgentConfig
 from .correction import Anchor
 from .encoder import Encoder, check_encoder, make_encoder
 from .localisation import Belief, Counts, corrected_frame, empty_memory, found_frame, scan_agrees, shifted, to_belief
-from .map_growth import expand, move_obstacles, recognised, state_poses, visited_prior, waypoint
-from .mapping import direction, reverse_heading
+from .map_growth import (
+    expand,
+    move_obstacles,
+    predicted,
+    recognised,
+    reverse,
+    state_poses,
+    visited_prior,
+    wander,
+    waypoint,
+)
 from .sensing import Sensed
 
 __all__ = ["AIMAPPAgent", "Decision", "Sensed", "initial_model"]
@@ -128,10 +137,18 @@ def initial_model(cfg: AgentConfig, pose0) -> Model:
     return compile(spec, prior_count=cfg.prior_count)
 
 
+def checked_scheme(cfg: AgentConfig, model: Model) -> Model:
+    """``model``, after checking that ``cfg.scheme`` accepts it (a ValueError naming those that do)."""
+    if not inference.accepts(cfg.scheme, model):
+        raise ValueError(f"AgentConfig.scheme: inference scheme '{cfg.scheme}' does not accept AIMAPP's "
+                         f"model; schemes that do: {', '.join(inference.accepting(model))}")
+    return model
+
+
 class AIMAPPAgent:
-    """The AIMAPP agent: its config, encoder, RNG, model and a state of three records
-    (:class:`~cogmap.agent.localisation.Belief`, :class:`~cogmap.agent.localisation.Counts`,
-    :class:`~cogmap.agent.localisation.Memory`); the maths lives in the functions it calls.
+    """The AIMAPP agent: config, encoder, RNG, model and a state of three records; the maths lives
+    in the functions it calls (:mod:`~cogmap.agent.localisation`, :mod:`~cogmap.agent.map_growth`,
+    :mod:`~cogmap.agent.planner`).
 
     The model is created at the first :meth:`step` (one state at the first believed pose) unless
     one is given (a learnt model, e.g. for goal reaching).
@@ -149,18 +166,12 @@ class AIMAPPAgent:
 
     Attributes
     ----------
-    cfg : AgentConfig
-        The parameters.
-    encoder : Encoder
-        Image -> observation id.
-    model : cogmap.genmodel.Model or None
-        The generative model (None before the first step).
-    belief : Belief
-        Posterior, belief frame (``q`` and ``frame`` are also properties of the agent), lost test.
-    counts : Counts
-        Steps taken, accepted drift corrections, times lost, times found again.
-    memory : Memory
-        Anchors, states scanned from, moves driven, belief-frame moves, the sensed grid.
+    cfg, encoder, model
+        The parameters, the image -> observation id encoder, the generative model (None before the
+        first step).
+    belief, counts, memory : Belief, Counts, Memory
+        Posterior, belief frame and lost test (``q`` and ``frame`` are also properties); steps and
+        events; anchors, states scanned from, moves driven, frame moves and the sensed grid.
     last : Decision or None
         The last decision.
     goal_obs : int or None
@@ -181,7 +192,7 @@ class AIMAPPAgent:
         check_encoder(self.encoder)
         inference.get(self.cfg.scheme)  # an unknown scheme: a KeyError naming the registered ones
         if model is not None:
-            self._check_scheme(model)
+            checked_scheme(self.cfg, model)
         self.rng = np.random.default_rng(seed)
         self.model = model
         self.belief = Belief(None, SE2())
@@ -231,11 +242,8 @@ class AIMAPPAgent:
                 and last.confidence is not None and last.confidence.confident)
 
     def localise_at(self, odometry) -> int:
-        """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``.
-
-        The posterior becomes one-hot on that state, the belief frame is shifted so the believed
-        pose is the state's stored pose, and the last decision is forgotten. Returns the state.
-        """
+        """Known start (section 4.1 goal protocol): believe (one-hot) the state nearest ``odometry``,
+        shift the frame onto its stored pose, forget the last decision; returns the state."""
         s, _ = self.model.pose_index().nearest(self.believed_pose(odometry))
         q = np.zeros(self.num_states)
         q[s] = 1.0
@@ -246,13 +254,8 @@ class AIMAPPAgent:
 
     def set_goal(self, obs: int | None) -> None:
         """Prefer observation ``obs`` (goal mode, section 4.4; C puts log-preference 1 on it, weighted
-        by ``cfg.goal_weight`` when planning), or return to exploration with ``None``.
-
-        Raises
-        ------
-        ValueError
-            When ``obs`` is not a known observation id.
-        """
+        by ``cfg.goal_weight`` when planning), or explore again with ``None``; a ValueError for an
+        unknown observation id."""
         if obs is not None and not 0 <= obs < self.model.num_obs[0]:
             raise ValueError(f"goal observation {obs} is unknown (have {self.model.num_obs[0]})")
         self.goal_obs = obs
@@ -280,13 +283,10 @@ class AIMAPPAgent:
         return self.model.A[0].taught(2 * self.cfg.prior_count)
 
     def step(self, sensed: Sensed) -> Decision:
-        """One sense -> infer -> learn -> plan cycle (sections 3.1-3.6, see the module docstring).
-
-        ``sensed`` is what the robot reports now (odometry frame; ``moved`` is the outcome of the
-        previous decision's command). Returns where to go next (waypoint in the odometry frame) and
-        why; mode ``"paused"`` (stay, nothing changed) while odometry is silent, or before the
-        model exists while any stream is.
-        """
+        """One sense -> infer -> learn -> plan cycle (sections 3.1-3.6, module docstring) on what the
+        robot reports now (odometry frame; ``moved``: the outcome of the last command). Returns where
+        to go (waypoint in the odometry frame) and why; ``"paused"`` (stay, nothing changed) while
+        odometry is silent, or before the model exists while any stream is."""
         self.counts = self.counts._replace(steps=self.counts.steps + 1)
         if self.last is not None and self.belief.outcome is None and sensed.moved is not None:
             self.belief = self.belief._replace(outcome=bool(sensed.moved))  # of the last real motion command
@@ -295,7 +295,7 @@ class AIMAPPAgent:
             return self._paused(sensed)  # nothing places the agent (or a first view is incomplete)
         pose = self.believed_pose(sensed.odometry)
         if self.model is None:
-            self.model = self._check_scheme(initial_model(self.cfg, pose))
+            self.model = checked_scheme(self.cfg, initial_model(self.cfg, pose))
             self.belief = self.belief._replace(q=np.ones(1))
         local = to_belief(self.frame, self.cfg, sensed)
         obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
@@ -346,12 +346,6 @@ class AIMAPPAgent:
         self.counts = self.counts._replace(corrections=self.counts.corrections + 1)
         return True
 
-    def _check_scheme(self, model: Model) -> Model:
-        if not inference.accepts(self.cfg.scheme, model):
-            raise ValueError(f"AgentConfig.scheme: inference scheme '{self.cfg.scheme}' does not accept AIMAPP's "
-                             f"model; schemes that do: {', '.join(inference.accepting(model))}")
-        return model
-
     def _observe(self, panorama) -> tuple[int, float]:
         """Observation id (a new id grows A_o) and the encoder's best similarity score."""
         obs, _ = self.encoder(panorama)
@@ -371,7 +365,8 @@ class AIMAPPAgent:
             prior = visited_prior(self.model, cfg)
             q = [prior] if obs is None else scheme(self.model, [prior], [{"view": obs}])[0]
         else:  # B_s prediction combined with A_o and A_p evidence
-            q, _ = scheme(self.model, [self._prior(b.outcome)], [{"view": obs, "pose": pose}])
+            q, _ = scheme(self.model, [predicted(self.model, cfg, self.q, self.last, b.outcome)],
+                          [{"view": obs, "pose": pose}])
         q = q[0]
         d2 = np.sum((self.poses - pose) ** 2, axis=1)
         near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are
@@ -414,14 +409,8 @@ class AIMAPPAgent:
     def _decide(self, sensed: Sensed, pose: np.ndarray, conf: Confidence, expanded: int) -> Decision:
         cfg = self.cfg
         state = int(np.argmax(self.q))
-        if self.belief.lost:
-            # The map position is unknown, so the graph cannot guide a move: step in a free
-            # direction of the real surroundings until a familiar view is recognised.
-            if sensed.obstacles is None:  # nothing says which way is free: wait for the LiDAR
-                return Decision(cfg.stay, self.to_odometry(pose), state, state, "relocalise", conf, expanded)
-            free = np.flatnonzero(~np.asarray(sensed.obstacles, dtype=bool))
-            action = int(self.rng.choice(free)) if free.size else cfg.stay
-            to = pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
+        if self.belief.lost:  # the graph cannot guide a move: a free direction, seeking familiar views
+            action, to = wander(cfg, self.rng, sensed.obstacles, pose)
             return Decision(action, self.to_odometry(to), state, state, "relocalise", conf, expanded)
         mode = "goal" if self.goal_obs is not None else "explore"
         flags = move_obstacles(self.model, cfg, self.memory.traversed, state, sensed.obstacles, sensed.scan, pose)
@@ -430,26 +419,6 @@ class AIMAPPAgent:
         return Decision(action, self.to_odometry(to), state, target, mode, conf, expanded, efe)
 
     # -- pieces ------------------------------------------------------------------------------
-    def _prior(self, moved: bool | None) -> np.ndarray:
-        """Predicted belief after the last move (Eq. 1: B_s applied to the last posterior).
-
-        A move the controller reported blocked is learnt first (experienced impossible, Table 7)
-        and predicts no change of state."""
-        q = np.zeros(self.num_states)
-        q[: self.q.size] = self.q
-        last = self.last
-        if last is None or last.action == self.cfg.stay:
-            return q
-        if moved is False:  # blocked: the robot stopped near where it started
-            if last.target != last.state:
-                learn_transition(self.model, 0, last.state, last.action, last.target, Event.IMPOSSIBLE,
-                                 reverse_control=self._reverse(last.action), rates=self.cfg.learning)
-            return q
-        return self.model.predict(0, q, last.action)
-
-    def _reverse(self, action: int) -> int | None:
-        return reverse_heading(action, self.cfg.num_headings) if action != self.cfg.stay else None
-
     def _learn(self, state: int, obs: int | None, sensed: Sensed, pose: np.ndarray, score: float) -> int:
         m, cfg, anchors = self.model, self.cfg, self.memory.anchors
         if obs is not None:
@@ -466,9 +435,9 @@ class AIMAPPAgent:
         arrived = last is None or state != last.state
         if last is not None and self.belief.outcome and state != last.state and last.action != cfg.stay:
             learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
-                             reverse_control=self._reverse(last.action), rates=cfg.learning)
+                             reverse_control=reverse(cfg, last.action), rates=cfg.learning)
             self.memory.traversed.add((int(last.state), int(last.action), state))
-            self.memory.traversed.add((state, int(self._reverse(last.action)), int(last.state)))
+            self.memory.traversed.add((state, int(reverse(cfg, last.action)), int(last.state)))
         if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
             return 0
         return expand(m, cfg, self.memory.traversed, state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan,

@@ -1,7 +1,8 @@
 """How AIMAPP's map grows and where its moves lead (sections 3.4-3.5): neighbours by heading, the
-collision test of a move, predicted (im)possible transitions and Eq. (7) expansion, and the waypoint
-of an action. Functions of the model (whose counts and states they update), the agent's config and
-the moves it has driven (``traversed``: ``(state, heading, state)`` triples, both ways)."""
+collision test of a move, predicted (im)possible transitions and Eq. (7) expansion, the waypoint
+of an action, the B_s prediction of the last move and the move while lost. Functions of the model
+(whose counts and states they update), the agent's config and the moves it has driven
+(``traversed``: ``(state, heading, state)`` triples, both ways)."""
 
 from __future__ import annotations
 
@@ -150,3 +151,37 @@ def waypoint(model: Model, cfg: AgentConfig, state: int, action: int) -> tuple[i
         target = int(B.succ[state, action, k])
         return target, poses[target].copy()
     return state, poses[state] + cfg.influence_radius * direction(action, cfg.num_headings)
+
+
+def reverse(cfg: AgentConfig, action: int) -> int | None:
+    """The heading opposite ``action`` (None for stay)."""
+    return reverse_heading(action, cfg.num_headings) if action != cfg.stay else None
+
+
+def predicted(model: Model, cfg: AgentConfig, q: np.ndarray, last, moved: bool | None) -> np.ndarray:
+    """Predicted belief after the last decision ``last`` (Eq. 1: B_s applied to the posterior ``q``).
+
+    A move the controller reported blocked (``moved`` False) is learnt first (experienced
+    impossible, Table 7) and predicts no change of state."""
+    full = np.zeros(model.num_states[0])
+    full[: q.size] = q
+    if last is None or last.action == cfg.stay:
+        return full
+    if moved is False:  # blocked: the robot stopped near where it started
+        if last.target != last.state:
+            learn_transition(model, 0, last.state, last.action, last.target, Event.IMPOSSIBLE,
+                             reverse_control=reverse(cfg, last.action), rates=cfg.learning)
+        return full
+    return model.predict(0, full, last.action)
+
+
+def wander(cfg: AgentConfig, rng: np.random.Generator, obstacles: np.ndarray | None,
+           pose: np.ndarray) -> tuple[int, np.ndarray]:
+    """While lost (the map position is unknown, so the graph cannot guide a move): a random free
+    heading of the real surroundings and its waypoint one influence radius away (belief frame);
+    stay while the LiDAR is silent (nothing says which way is free)."""
+    if obstacles is None:
+        return cfg.stay, pose
+    free = np.flatnonzero(~np.asarray(obstacles, dtype=bool))
+    action = int(rng.choice(free)) if free.size else cfg.stay
+    return action, pose if action == cfg.stay else pose + cfg.influence_radius * direction(action, cfg.num_headings)
