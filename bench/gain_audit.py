@@ -55,7 +55,7 @@ def audit_run(env: str, seed: int, steps: int) -> list[dict]:
     def on_step(sim, agent):  # after the planning call, before the move
         nonlocal last
         cfg, views, grid = agent.cfg, agent.memory.views, sim.grid
-        v = views.viewpoint
+        v = views.pursuit.viewpoint
         if v is None or (last is not None and np.hypot(*(v - last)) <= cfg.view_keep_radius):
             return
         last = v.copy()

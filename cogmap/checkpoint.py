@@ -131,7 +131,7 @@ def _exploration_schema() -> Struct:
     from cogmap.agent.encoder import SSIMEncoder
     from cogmap.agent.exploration_end import Done
     from cogmap.agent.localisation import Belief, Counts, Memory
-    from cogmap.agent.viewmap import ViewMap
+    from cogmap.agent.viewmap import Pursuit, ViewMap
     from cogmap.envs.robot import Odometry, OdometryNoise
     from cogmap.envs.sensors import STREAMS, FaultSchedule
     from cogmap.inference.se2 import SE2
@@ -162,9 +162,9 @@ def _exploration_schema() -> Struct:
     views = s.Record(ViewMap, {
         "cfg": config, "grid": s.Optional(grid), "area": s.Array("f", 1), "robot": s.Optional(xy),
         "returns": s.Array("f", 2), "frontier_cache": s.DictOf(s.TupleOf(fin, fin), s.Float(finite=False)),
-        "_dirty_states": box, "_dirty_frontier": box, "doubt": s.SetOf(state), "target": index,
-        "unreached": count, "full": fin, "viewpoint": s.Optional(xy),
-        "spent": s.ListOf(s.TupleOf(xy, fin)), "spent_at": count, "blind": s.Bool()})
+        "_dirty_states": box, "_dirty_frontier": box, "doubt": s.SetOf(state),
+        "pursuit": s.Record(Pursuit, {"target": index, "viewpoint": s.Optional(xy), "unreached": count,
+                                      "spent": s.ListOf(s.TupleOf(xy, fin)), "spent_at": count, "blind": s.Bool()})})
     anchor = s.Record(Anchor, {"pose": xy, "panorama": s.Array("uif"), "scan": s.Array("f", 2), "step": count})
     se2 = s.Record(SE2, {"yaw": fin, "x": fin, "y": fin}, make="call")
     belief = s.Record(Belief, {"q": s.Array("f", 1), "frame": se2, "lost": s.Bool(),

@@ -309,7 +309,7 @@ class AIMAPPAgent:
         if self.frame is not frame:
             self._record_frame_move("relocalisation", pose, sensed.odometry)
         views = self.memory.views
-        views.blind = sensed.scan is None
+        views.pursuit.blind = sensed.scan is None
         if not self.belief.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
             views.observe(self, sensed)
             if conf.confident:

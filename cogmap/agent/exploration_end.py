@@ -67,10 +67,10 @@ class Done:
         self.quiet = self.quiet + 1 if seen == self.seen else 0
         self.seen = seen
         sensing = decision.mode == "explore" and a.cfg.view_weighting and a.memory.views.grid is not None
-        nothing_left = sensing and a.memory.views.target < 0
+        nothing_left = sensing and a.memory.views.pursuit.target < 0
         if getattr(self, "rule", "seen-all") == "liveness":
-            nothing_left = nothing_left and getattr(a.memory.views, "unreached", 0) == 0
-        self.pursuing = bool(sensing and a.memory.views.target >= 0)
+            nothing_left = nothing_left and a.memory.views.pursuit.unreached == 0
+        self.pursuing = bool(sensing and a.memory.views.pursuit.target >= 0)
         self.seen_all = self.seen_all + 1 if nothing_left else 0
         return self.finished
 

@@ -26,8 +26,9 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     a new state of the map lies nearer to it (the robot stands as near to it as the map allows;
     nothing is set aside while the LiDAR is silent, since the map cannot grow then), as the oracle's viewpoints
     are once stood on. Empty when no viewpoint is left or none is brought nearer; then
-    ``views.unreached`` counts the viewpoints and the paper's terms alone decide."""
+    ``views.pursuit.unreached`` counts the viewpoints and the paper's terms alone decide."""
     cfg, views, B, n = agent.cfg, agent.memory.views, agent.model.B[0], agent.num_states
+    aim = views.pursuit
     poses, visited = agent.poses[:n], agent.scanned_from()[:n].astype(bool)
     xy, gains = views.viewpoints(poses, visited, areas)
     src, dst = B.edges(cfg.inductive_threshold, n)
@@ -35,36 +36,35 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     if doubt.size:  # a believed transition crosses a newly sensed obstacle: its source has information
         xy = np.vstack([xy, poses[doubt]])
         gains = np.concatenate([gains, np.full(doubt.size, cfg.view_min_area)])
-    views.target, views.unreached = -1, 0
+    aim.target, aim.unreached = -1, 0
     if gains.size == 0:
-        views.viewpoint = None
+        aim.viewpoint = None
         return np.zeros(0, dtype=np.int64)
     grid = views.grid
     path = sensed.lookup_near(grid, sensed.path_lengths(grid, poses[state]), xy)
     keep = -1
-    if views.viewpoint is not None:
-        d = np.hypot(*(xy - views.viewpoint).T)
+    if aim.viewpoint is not None:
+        d = np.hypot(*(xy - aim.viewpoint).T)
         keep = int(np.argmin(d)) if d.min() <= cfg.view_keep_radius else -1
     order = sensed.rank_viewpoints(gains, path, cfg.view_detour, keep=keep, keep_ratio=cfg.view_keep_ratio)
     steps = ind.goal_distances(dst, src, np.array([state]), n, cfg.inductive_depth).astype(float)
     steps[steps >= ind.UNREACHABLE] = np.inf
-    if views.spent_at != n:  # the map changed: a viewpoint comes back when a new state lies nearer to it
-        views.spent = _revive(views.spent, poses[views.spent_at:n] if n > views.spent_at else None,
-                              cfg.view_keep_radius)
-        views.spent_at = n
-    if views.spent:  # set-aside viewpoints do not use up the tries
-        order = order[~sensed.near_any(xy[order], np.array([p for p, _ in views.spent]), 0.3)]
+    if aim.spent_at != n:  # the map changed: a viewpoint comes back when a new state lies nearer to it
+        aim.spent = _revive(aim.spent, poses[aim.spent_at:n] if n > aim.spent_at else None, cfg.view_keep_radius)
+        aim.spent_at = n
+    if aim.spent:  # set-aside viewpoints do not use up the tries
+        order = order[~sensed.near_any(xy[order], np.array([p for p, _ in aim.spent]), 0.3)]
     for j in order[: cfg.view_tries]:
         # the state with the shortest rest of the way to the viewpoint, a metre of believed path
         # to it counting view_path_weight metres; none but the robot's own: set it aside
         way = sensed.lookup_near(grid, sensed.path_lengths(grid, xy[j]), poses)
         s = sensed.state_toward(way, steps, cfg.influence_radius, cfg.view_path_weight)
         if s >= 0 and s != state:
-            views.viewpoint, views.target = xy[j].copy(), s
+            aim.viewpoint, aim.target = xy[j].copy(), s
             return np.array([s])
-        if not views.blind:  # without the LiDAR the map cannot grow toward it: not a reason to give up
-            views.spent.append((xy[j].copy(), float(np.hypot(*(poses - xy[j]).T).min())))
-    views.viewpoint, views.unreached = None, int(order.size)  # viewpoints with a path, none brought nearer
+        if not aim.blind:  # without the LiDAR the map cannot grow toward it: not a reason to give up
+            aim.spent.append((xy[j].copy(), float(np.hypot(*(poses - xy[j]).T).min())))
+    aim.viewpoint, aim.unreached = None, int(order.size)  # viewpoints with a path, none brought nearer
     return np.zeros(0, dtype=np.int64)
 
 

@@ -3,9 +3,45 @@ would still reveal (the stateful side of ``cogmap.planning.sensed``)."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
+from functools import lru_cache
+
 import numpy as np
 
 from cogmap.planning import sensed as sg
+
+
+@dataclass
+class Pursuit:
+    """The view-weighted target the planner pursues (:mod:`cogmap.agent.planner`).
+
+    Attributes
+    ----------
+    target : int
+        State pursued by the inductive term (kept while nearly the best), -1 for none.
+    viewpoint : numpy.ndarray or None
+        The viewpoint pursued (its state is ``target``).
+    unreached : int
+        States that promise information but no believed-possible path reaches.
+    spent : list of (numpy.ndarray, float)
+        ``(viewpoint, nearest state distance)`` set aside until a new state lies nearer.
+    spent_at : int
+        Number of states when ``spent`` was started.
+    blind : bool
+        The LiDAR is silent at this step: the map cannot grow, nothing is set aside.
+    """
+
+    target: int = -1
+    viewpoint: np.ndarray | None = None
+    unreached: int = 0
+    spent: list = field(default_factory=list)
+    spent_at: int = 0
+    blind: bool = False
+
+
+@lru_cache(maxsize=32)
+def _full_area(radius: float, rays: int, resolution: float, free_path: bool) -> float:
+    return sg.view_area(radius, rays, resolution, free_path=free_path)
 
 
 class ViewMap:
@@ -24,13 +60,13 @@ class ViewMap:
         self.frontier_cache: dict = {}  # frontier point -> unseen area, while nothing near it changes
         self._dirty_states = self._dirty_frontier = None  # box of cells changed since the last query
         self.doubt: set[int] = set()  # states beside a moved obstacle, preferred until visited
-        self.target = -1  # state pursued by the inductive term (kept while nearly the best)
-        self.unreached = 0  # states that promise information but no believed-possible path reaches
-        self.full = sg.view_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution, free_path=cfg.view_free_path)
-        self.viewpoint: np.ndarray | None = None  # the viewpoint pursued (its state is ``target``)
-        self.spent: list = []  # (viewpoint, nearest state distance) set aside until a new state lies nearer
-        self.spent_at = 0  # number of states when ``spent`` was started
-        self.blind = False  # the LiDAR is silent at this step: the map cannot grow, nothing is set aside
+        self.pursuit = Pursuit()  # the view-weighted target the planner pursues
+
+    @property
+    def full(self) -> float:
+        """Area (m2) of a view with nothing yet seen."""
+        cfg = self.cfg
+        return _full_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution, cfg.view_free_path)
 
     def observe(self, agent, sensed) -> None:
         """Add the scan of ``sensed`` (points relative to the robot, odometry frame) to the grid,

@@ -112,9 +112,6 @@ class DroneAgent(DronePolicy):
     def __init__(self, config: DroneAgentConfig | None = None, seed: int = 0, speeds=(2.0, 1.5)):
         self.config = config or DroneAgentConfig()
         self.model = KernelBeliefModel()
-        self.scheme = inference.get("kernel")
-        self.planner = get_planner("drone")
-        self.objective = drone_objective(self.config.planner.w_pragmatic, self.config.planner.w_epistemic)
         self.rng = np.random.default_rng(seed)
         self.speeds = speeds
         self.reset()
@@ -214,13 +211,14 @@ class DroneAgent(DronePolicy):
         # moveToPositionAsync keeps the take-off yaw, so the egocentric frame is the world frame
         obs = {**egocentric_state(pos, tgt, 0.0), "suitability": S, "density": min(rho, 1.0)}
         prior = self.beliefs if self.config.persistent_beliefs else None
-        beliefs, _ = self.scheme(self.model, prior, [obs])
+        beliefs, _ = inference.get("kernel")(self.model, prior, [obs])
         self.beliefs = beliefs
         H = [entropy(b) for b in beliefs]
         scene = DroneScene(pos, tgt, V, d_obs, rho, S, self.d_start, np.array(self.visited).reshape(-1, 3),
                            self.config.planner)
         settings = PlanSettings(policy_len=self.config.depth, rng=self.rng)
-        plan = self.planner(scene, beliefs, self.objective, settings).info
+        objective = drone_objective(self.config.planner.w_pragmatic, self.config.planner.w_epistemic)
+        plan = get_planner("drone")(scene, beliefs, objective, settings).info
         plan_ms = 1e3 * (time.perf_counter() - t0)
         self.visited.append(pos.copy())
         d_tgt = float(np.linalg.norm(tgt - pos))
