@@ -45,19 +45,9 @@ def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_
 
     Parameters
     ----------
-    model : Model
-        Compiled model (:func:`cogmap.genmodel.compile`).
-    prior : list of numpy.ndarray
-        One belief per factor at the first step, before its observation: ``(num_states[f],)`` float
-        (or capacity length with no mass beyond the live states), sums to 1.
-    observations : sequence
-        ``T >= 1`` steps; each a list with one entry per modality (plus the metric pose ``(x, y)``
-        in metres when the model has a pose factor) or a dict keyed by modality name (and
-        ``"pose"``). An entry is an outcome index, a distribution over the live outcomes, or None
-        (missing). See :mod:`cogmap.inference.base`.
-    actions : sequence, optional
-        ``T - 1`` control tuples, one integer per factor (a bare int for one factor); may be omitted
-        when every factor has a single control.
+    model, prior, observations, actions
+        The arguments every scheme takes (:class:`cogmap.genmodel.contracts.InferenceScheme`), checked
+        and documented by :func:`cogmap.inference.base.prepare`.
     smooth : bool, optional
         Whether ``info.history`` holds smoothed (forward-backward) marginals (default) or filtered ones.
     max_joint : int, optional

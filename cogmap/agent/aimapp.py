@@ -36,23 +36,17 @@ import numpy as np
 
 from cogmap import inference
 from cogmap.genmodel import Factor, InductiveSpec, Modality, Model, ModelSpec, PoseSpec, SparseA, SparseB, compile
-from cogmap.inference.learning import Event, learn_observation, learn_transition
 from cogmap.inference.se2 import SE2, apply, apply_pose, invert
 
 from . import planner
-from .confidence import Confidence, assess, cusum
+from .confidence import Confidence
 from .config import AgentConfig
-from .correction import Anchor
+from .cycle import infer, update
 from .encoder import Encoder, check_encoder, make_encoder
-from .localisation import Belief, Counts, corrected_frame, empty_memory, found_frame, scan_agrees, shifted, to_belief
+from .localisation import Belief, Counts, corrected_frame, empty_memory, shifted, to_belief
 from .map_growth import (
-    expand,
     move_obstacles,
-    predicted,
-    recognised,
-    reverse,
     state_poses,
-    visited_prior,
     wander,
     waypoint,
 )
@@ -138,7 +132,25 @@ def initial_model(cfg: AgentConfig, pose0) -> Model:
 
 
 def checked_scheme(cfg: AgentConfig, model: Model) -> Model:
-    """``model``, after checking that ``cfg.scheme`` accepts it (a ValueError naming those that do)."""
+    """``model``, after checking that the inference scheme ``cfg.scheme`` accepts it.
+
+    Parameters
+    ----------
+    cfg : AgentConfig
+        Names the scheme.
+    model : Model
+        AIMAPP's model.
+
+    Returns
+    -------
+    Model
+        ``model`` itself.
+
+    Raises
+    ------
+    ValueError
+        The scheme does not accept the model (the message names those that do).
+    """
     if not inference.accepts(cfg.scheme, model):
         raise ValueError(f"AgentConfig.scheme: inference scheme '{cfg.scheme}' does not accept AIMAPP's "
                          f"model; schemes that do: {', '.join(inference.accepting(model))}")
@@ -146,12 +158,10 @@ def checked_scheme(cfg: AgentConfig, model: Model) -> Model:
 
 
 class AIMAPPAgent:
-    """The AIMAPP agent: config, encoder, RNG, model and a state of three records; the maths lives
-    in the functions it calls (:mod:`~cogmap.agent.localisation`, :mod:`~cogmap.agent.map_growth`,
-    :mod:`~cogmap.agent.planner`).
-
-    The model is created at the first :meth:`step` (one state at the first believed pose) unless
-    one is given (a learnt model, e.g. for goal reaching).
+    """The AIMAPP agent: config, encoder, RNG, model and a state of three records; the maths lives in
+    the functions it calls (:mod:`~cogmap.agent.cycle`, :mod:`~cogmap.agent.localisation`,
+    :mod:`~cogmap.agent.map_growth`, :mod:`~cogmap.agent.planner`). The model is created at the
+    first :meth:`step` unless one is given (a learnt model, e.g. for goal reaching).
 
     Parameters
     ----------
@@ -223,15 +233,48 @@ class AIMAPPAgent:
         return self.belief.frame
 
     def believed_pose(self, odometry) -> np.ndarray:
-        """Believed ``(2,)`` position (metres, belief frame) of an odometry pose ``(x, y[, yaw])``."""
+        """Believed (x, y) of an odometry pose (``frame`` applied).
+
+        Parameters
+        ----------
+        odometry : array_like
+            Odometry pose ``(x, y[, yaw])``, metres; only x, y are read.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(2,)`` float position, metres, belief frame.
+        """
         return apply(self.frame, np.asarray(odometry, dtype=float)[:2])
 
     def believed_pose_yaw(self, odometry) -> np.ndarray:
-        """Believed ``(3,)`` pose of an odometry pose ``(x, y, yaw)``, yaw wrapped to [-pi, pi)."""
+        """Believed (x, y, yaw) of an odometry pose (x, y, yaw).
+
+        Parameters
+        ----------
+        odometry : array_like
+            ``(3,)`` odometry pose, metres and radians (a ``(2,)`` position gives a position).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(3,)`` float pose in the belief frame, yaw wrapped to [-pi, pi).
+        """
         return apply_pose(self.frame, odometry)
 
     def to_odometry(self, xy) -> np.ndarray:
-        """Belief-frame points ``(..., 2)`` in the odometry frame (where the simulator drives)."""
+        """A belief-frame point in the odometry frame (where the simulator drives).
+
+        Parameters
+        ----------
+        xy : array_like
+            ``(..., 2)`` points, metres, belief frame.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(..., 2)`` float points, metres, odometry frame.
+        """
         return apply(invert(self.frame), xy)
 
     @property
@@ -242,8 +285,21 @@ class AIMAPPAgent:
                 and last.confidence is not None and last.confidence.confident)
 
     def localise_at(self, odometry) -> int:
-        """Known start (section 4.1 goal protocol): believe (one-hot) the state nearest ``odometry``,
-        shift the frame onto its stored pose, forget the last decision; returns the state."""
+        """Known start (section 4.1 goal protocol): believe the state nearest ``odometry``.
+
+        The posterior becomes one-hot on that state, the belief frame is shifted so the believed
+        pose is the state's stored pose, and the last decision is forgotten.
+
+        Parameters
+        ----------
+        odometry : array_like
+            Current odometry pose ``(x, y[, yaw])``, metres.
+
+        Returns
+        -------
+        int
+            The state now believed.
+        """
         s, _ = self.model.pose_index().nearest(self.believed_pose(odometry))
         q = np.zeros(self.num_states)
         q[s] = 1.0
@@ -253,9 +309,19 @@ class AIMAPPAgent:
         return s
 
     def set_goal(self, obs: int | None) -> None:
-        """Prefer observation ``obs`` (goal mode, section 4.4; C puts log-preference 1 on it, weighted
-        by ``cfg.goal_weight`` when planning), or explore again with ``None``; a ValueError for an
-        unknown observation id."""
+        """Prefer observation ``obs`` (goal mode, section 4.4), or return to exploration with ``None``.
+
+        Parameters
+        ----------
+        obs : int or None
+            Observation id of the goal: C puts log-preference 1 on it (0 elsewhere), weighted by
+            ``cfg.goal_weight`` when planning. None clears the preference.
+
+        Raises
+        ------
+        ValueError
+            When ``obs`` is not a known observation id.
+        """
         if obs is not None and not 0 <= obs < self.model.num_obs[0]:
             raise ValueError(f"goal observation {obs} is unknown (have {self.model.num_obs[0]})")
         self.goal_obs = obs
@@ -264,29 +330,64 @@ class AIMAPPAgent:
             self.model.C[0][obs] = 1.0
 
     def goal_states(self, min_prob: float = 0.5) -> np.ndarray:
-        """States (ascending) whose ``A_o[goal, s]`` is at least ``min_prob`` of the row's largest
-        entry (and at least 1e-9); empty without a goal."""
+        """States whose observation model favours the goal observation.
+
+        Parameters
+        ----------
+        min_prob : float, optional
+            A state counts when ``A_o[goal, s]`` is at least this fraction of the largest entry
+            of that row (and at least 1e-9), default 0.5.
+
+        Returns
+        -------
+        numpy.ndarray
+            Int state indices, ascending; empty without a goal.
+        """
         if self.goal_obs is None:
             return np.zeros(0, dtype=int)
         row = self.model.A_row(0, self.goal_obs)
         return np.flatnonzero(row >= max(min_prob * row.max(), 1e-9))
 
     def scanned_from(self) -> np.ndarray:
-        """``(num_states,)`` bool: states the agent has stood on with its LiDAR reporting (what their
-        view can reveal has been seen; a state passed while the LiDAR was silent still promises it)."""
+        """Mask of states the agent has stood on with its LiDAR reporting: what their view can
+        reveal has been seen (a state passed while the LiDAR was silent still promises it).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(num_states,)`` bool.
+        """
         mask = np.zeros(self.num_states, dtype=bool)
         mask[list(self.memory.scanned)] = True
         return mask
 
     def visited(self) -> np.ndarray:
-        """``(num_states,)`` bool: states whose A_o column's largest count exceeds ``2 * prior_count``."""
+        """Mask of states whose observation model has been taught (the agent has been there).
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(num_states,)`` bool: the largest count of the state's A_o column exceeds
+            ``2 * prior_count``.
+        """
         return self.model.A[0].taught(2 * self.cfg.prior_count)
 
     def step(self, sensed: Sensed) -> Decision:
-        """One sense -> infer -> learn -> plan cycle (sections 3.1-3.6, module docstring) on what the
-        robot reports now (odometry frame; ``moved``: the outcome of the last command). Returns where
-        to go (waypoint in the odometry frame) and why; ``"paused"`` (stay, nothing changed) while
-        odometry is silent, or before the model exists while any stream is."""
+        """One sense -> infer -> learn -> plan cycle (sections 3.1-3.6, see the module docstring).
+
+        Parameters
+        ----------
+        sensed : Sensed
+            What the robot reports now (odometry frame); ``moved`` is the outcome of the command
+            of the previous decision.
+
+        Returns
+        -------
+        Decision
+            Where to go next (waypoint in the odometry frame) and why; mode ``"paused"`` (stay,
+            nothing changed) while odometry is silent, or before the model exists while any
+            stream is.
+        """
         self.counts = self.counts._replace(steps=self.counts.steps + 1)
         if self.last is not None and self.belief.outcome is None and sensed.moved is not None:
             self.belief = self.belief._replace(outcome=bool(sensed.moved))  # of the last real motion command
@@ -299,13 +400,17 @@ class AIMAPPAgent:
             self.belief = self.belief._replace(q=np.ones(1))
         local = to_belief(self.frame, self.cfg, sensed)
         obs, score = self._observe(local.panorama) if local.panorama is not None else (None, 0.0)
-        q, conf = self._infer(obs, pose)
-        if self._correct(q, conf, local, pose):  # a recognised place moved the belief frame
+        q, conf = infer(self.model, self.cfg, self.belief, self.last, obs, pose)
+        frame = corrected_frame(self.belief, self.memory.anchors, self.cfg, q, conf.confident, self.last, local, pose)
+        if frame is not None:  # a recognised place moved the belief frame
+            self.belief = self.belief._replace(frame=frame)
+            self.counts = self.counts._replace(corrections=self.counts.corrections + 1)
             self._record_frame_move("correction", pose, sensed.odometry)
             pose = self.believed_pose(sensed.odometry)
             local = to_belief(self.frame, self.cfg, sensed)
         frame = self.frame
-        expanded = self._update(q, conf, obs, local, pose, score)
+        self.belief, self.counts, expanded = update(self.model, self.cfg, self.belief, self.counts, self.memory,
+                                                    self.last, q, conf, obs, local, pose, score)
         if self.frame is not frame:
             self._record_frame_move("relocalisation", pose, sensed.odometry)
         views = self.memory.views
@@ -331,21 +436,6 @@ class AIMAPPAgent:
         here = np.zeros(2) if sensed.odometry is None else np.asarray(sensed.odometry, dtype=float)[:2]
         return Decision(self.cfg.stay, here, state, state, "paused", missing=sensed.missing)
 
-    def _correct(self, q: np.ndarray, conf: Confidence, local: Sensed, pose: np.ndarray) -> bool:
-        """Drift correction once per confident arrival (section 3.3); returns whether the frame moved."""
-        if self.belief.lost or not conf.confident or local.scan is None:
-            return False
-        state, last = int(np.argmax(q)), self.last
-        if last is not None and last.state == state:
-            return False  # compare once per arrival
-        frame = corrected_frame(self.frame, self.memory.anchors, self.cfg, state,
-                                None if last is None else last.state, local, pose)
-        if frame is None:
-            return False
-        self.belief = self.belief._replace(frame=frame)
-        self.counts = self.counts._replace(corrections=self.counts.corrections + 1)
-        return True
-
     def _observe(self, panorama) -> tuple[int, float]:
         """Observation id (a new id grows A_o) and the encoder's best similarity score."""
         obs, _ = self.encoder(panorama)
@@ -355,56 +445,6 @@ class AIMAPPAgent:
             # taught column keeps its certainty as the vocabulary of views grows
             self.model.add_observation(0)
         return obs, float(np.max(self.encoder.last_scores, initial=0.0))
-
-    def _infer(self, obs: int | None, pose: np.ndarray) -> tuple[np.ndarray, Confidence]:
-        """Posterior over states and the confidence test (section 3.3, A.1.2); ``obs`` is None
-        while the camera is silent (the pose evidence alone then localises)."""
-        cfg, b = self.cfg, self.belief
-        scheme = inference.get(cfg.scheme)  # the paper's exact filter by default (AgentConfig.scheme)
-        if b.lost:  # re-localising: odometry is not trusted, only what is seen
-            prior = visited_prior(self.model, cfg)
-            q = [prior] if obs is None else scheme(self.model, [prior], [{"view": obs}])[0]
-        else:  # B_s prediction combined with A_o and A_p evidence
-            q, _ = scheme(self.model, [predicted(self.model, cfg, self.q, self.last, b.outcome)],
-                          [{"view": obs, "pose": pose}])
-        q = q[0]
-        d2 = np.sum((self.poses - pose) ** 2, axis=1)
-        near = np.exp(-(d2 - d2.min()) / (2 * cfg.influence_radius**2))  # where the pose says we are
-        row = None if obs is None else self.model.A_row(0, obs)
-        return q, assess(q, near, row, cfg.z_threshold, b.lost_evidence, cfg.lost_slack)
-
-    def _update(self, q: np.ndarray, conf: Confidence, obs: int | None, sensed: Sensed, pose: np.ndarray,
-                score: float) -> int:
-        """Lost/found bookkeeping and learning; returns how many states the map gained."""
-        cfg, b, counts, anchors = self.cfg, self.belief, self.counts, self.memory.anchors
-        state = int(np.argmax(q))
-        expanded = 0
-        if not b.lost and conf.conflict > cfg.lost_slack and scan_agrees(anchors, self.poses, cfg, sensed.scan, pose):
-            # the view points elsewhere but the LiDAR matches the place the belief is at: aliasing
-            # (repeated racks, similar rooms), not a wrong position; it adds no evidence of being lost
-            evidence = cusum(b.lost_evidence, 0.0, cfg.lost_slack)
-            conf = conf._replace(conflict=0.0, lost_evidence=evidence, confident=conf.dominance >= cfg.z_threshold)
-        if b.lost:
-            # a familiar view singles out a place (and, with a LiDAR, the scan confirms it)
-            if obs is not None and q[state] >= 0.5 and recognised(self.model, cfg, state, obs):
-                frame = found_frame(b.frame, anchors.get(state), cfg, self.poses[state], sensed, pose)
-                if frame is not None:
-                    self.belief = b._replace(frame=frame, lost=False, lost_evidence=0.0)
-                    self.counts = counts._replace(relocalisations=counts.relocalisations + 1)
-        elif conf.lost(cfg.z_threshold):
-            self.belief = b._replace(lost=True, lost_evidence=0.0)
-            self.counts = counts._replace(lost_events=counts.lost_events + 1)
-            q = visited_prior(self.model, cfg)
-        else:
-            self.belief = b._replace(lost_evidence=conf.lost_evidence)
-            if conf.confident:
-                expanded = self._learn(state, obs, sensed, pose, score)
-            elif obs is not None:  # unsure between nearby states: learn A_o under the posterior (Eq. 8)
-                learn_observation(self.model, 0, obs, [q], lr=cfg.obs_learning_rate)
-        full = np.zeros(self.num_states)
-        full[: q.size] = q
-        self.belief = self.belief._replace(q=full)
-        return expanded
 
     def _decide(self, sensed: Sensed, pose: np.ndarray, conf: Confidence, expanded: int) -> Decision:
         cfg = self.cfg
@@ -417,28 +457,3 @@ class AIMAPPAgent:
         action, efe = planner.decide(self, state, flags, mode)
         target, to = waypoint(self.model, cfg, state, action)
         return Decision(action, self.to_odometry(to), state, target, mode, conf, expanded, efe)
-
-    # -- pieces ------------------------------------------------------------------------------
-    def _learn(self, state: int, obs: int | None, sensed: Sensed, pose: np.ndarray, score: float) -> int:
-        m, cfg, anchors = self.model, self.cfg, self.memory.anchors
-        if obs is not None:
-            onehot = np.zeros(self.num_states)
-            onehot[state] = 1.0
-            if sensed.scan is None and recognised(m, cfg, state, obs) and score >= cfg.relocalise_ssim:
-                # no LiDAR to align: a familiar, nearly identical view re-localises onto the state's pose
-                self.belief = self.belief._replace(frame=shifted(self.frame, self.poses[state] - pose))
-            elif state not in anchors and sensed.scan is not None and np.ndim(sensed.panorama) >= 2:
-                anchors[state] = Anchor(pose.copy(), np.asarray(sensed.panorama).copy(), sensed.scan.copy(),
-                                        self.counts.steps)
-            learn_observation(m, 0, obs, [onehot], lr=cfg.obs_learning_rate)
-        last = self.last
-        arrived = last is None or state != last.state
-        if last is not None and self.belief.outcome and state != last.state and last.action != cfg.stay:
-            learn_transition(m, 0, last.state, last.action, state, Event.POSSIBLE,
-                             reverse_control=reverse(cfg, last.action), rates=cfg.learning)
-            self.memory.traversed.add((int(last.state), int(last.action), state))
-            self.memory.traversed.add((state, int(reverse(cfg, last.action)), int(last.state)))
-        if not arrived or sensed.obstacles is None:  # without the LiDAR, no free direction is known
-            return 0
-        return expand(m, cfg, self.memory.traversed, state, np.asarray(sensed.obstacles, dtype=bool), sensed.scan,
-                      pose)

@@ -117,13 +117,20 @@ def to_belief(frame: SE2, cfg: AgentConfig, sensed: Sensed) -> Sensed:
     return Sensed(pano, obstacles, sensed.odometry, sensed.moved, scan, sweep)
 
 
-def corrected_frame(frame: SE2, anchors: dict, cfg: AgentConfig, state: int, last_state: int | None,
+def corrected_frame(belief: Belief, anchors: dict, cfg: AgentConfig, q: np.ndarray, confident: bool, last,
                     local: Sensed, pose: np.ndarray) -> SE2 | None:
-    """Drift correction (section 3.3) on arriving confidently at ``state`` from ``last_state``:
-    the place's anchor (its view and scan) or, on a first visit, the anchor of the place just left
-    (its scan), aligned with the current reading (``correction.relocalise`` / ``track``). Returns
-    the corrected frame, or None when nothing is recognised or the correction is within the
-    alignment's own error."""
+    """Drift correction (section 3.3), once per confident arrival at the state ``q`` names (not
+    while lost, not without a scan): the place's anchor (its view and scan) or, on a first visit,
+    the anchor of the place just left (its scan), aligned with the current reading
+    (``correction.relocalise`` / ``track``). Returns the corrected frame, or None when nothing is
+    recognised or the correction is within the alignment's own error."""
+    if belief.lost or not confident or local.scan is None:
+        return None
+    state = int(np.argmax(q))
+    last_state = None if last is None else last.state
+    if last_state == state:
+        return None  # compare once per arrival
+    frame = belief.frame
     reach = cfg.relocalise_max_correction * cfg.influence_radius
     anchor = anchors.get(state)
     if anchor is not None and np.ndim(local.panorama) >= 2:  # a revisit: the place's own view and scan
