@@ -229,6 +229,28 @@ class Frontier:
     cost: float
 
 
+@dataclass
+class GoalTrack:
+    """The frontier goal pursued and the progress toward it (explore_lite's blacklisting).
+
+    Attributes
+    ----------
+    goal : numpy.ndarray or None
+        ``(2,)`` goal, metres, odometry frame; None without one.
+    best : float
+        Best progress measure so far (path length or distance to the goal, metres).
+    stuck : int
+        Decisions without progress.
+    failures : int
+        Failed moves (or attempts) toward the goal.
+    """
+
+    goal: np.ndarray | None = None
+    best: float = np.inf
+    stuck: int = 0
+    failures: int = 0
+
+
 class FrontierExplorer(BaselinePolicy):
     """Greedy frontier exploration (Yamauchi 1997, explore_lite goal cost) on the robot's odometry-frame map.
 
@@ -246,14 +268,20 @@ class FrontierExplorer(BaselinePolicy):
         self.cfg = config or FrontierConfig()
         self.map: OdomMap | None = None
         self.blacklist: list[np.ndarray] = []
-        self.goal: np.ndarray | None = None
-        self.best_progress = np.inf
-        self.stuck_steps = 0
-        self.failures = 0
+        self.track = GoalTrack()
         self.last_heading: float | None = None
         self.frontiers: list[Frontier] = []
-        self.blacklisted = 0
         self.done = False
+
+    @property
+    def goal(self) -> np.ndarray | None:
+        """The frontier goal pursued (``(2,)`` metres, odometry frame), None without one."""
+        return self.track.goal
+
+    @property
+    def blacklisted(self) -> int:
+        """Number of goals blacklisted so far."""
+        return len(self.blacklist)
 
     # ------------------------------------------------------------------ map
     def observe(self, odom, ranges, angles, moved: bool | None) -> None:
@@ -276,12 +304,12 @@ class FrontierExplorer(BaselinePolicy):
         if self.map is None:
             self.map = OdomMap(odom[:2], cfg.map_size, cfg.resolution)
         if moved is False and self.last_heading is not None:
-            self.failures += 1
+            self.track.failures += 1
             h = self.last_heading
             bump = odom[:2] + (cfg.robot_radius + 0.05) * np.array([np.cos(h), np.sin(h)])
             self.map.mark_occupied(bump, 0.05)
         elif moved:
-            self.failures = 0
+            self.track.failures = 0
         if ranges is not None:
             self.map.integrate(odom, ranges, angles, cfg.lidar_range)
 
@@ -374,18 +402,16 @@ class FrontierExplorer(BaselinePolicy):
             k = int(np.ceil((cfg.robot_radius + cfg.inflation_margin) / (res * f)))
             blocked[max(0, start[0] - k):start[0] + k + 1, max(0, start[1] - k):start[1] + k + 1] = False
         dist, pred = shortest_paths(blocked, start)
-        self._plan = (pred, blocked, (r0, c0))
-        self._dist = dist  # path length (planning cells) from the robot to every cell
+        self._plan = (pred, blocked, (r0, c0), dist)  # dist: path length (planning cells) to every cell
         return dist
 
     def _blacklisted(self, xy) -> bool:
         return any(np.hypot(*(xy - b)) < self.cfg.blacklist_radius for b in self.blacklist)
 
     def _blacklist_goal(self) -> None:
-        if self.goal is not None:
-            self.blacklist.append(self.goal.copy())
-            self.blacklisted += 1
-        self.goal, self.best_progress, self.stuck_steps, self.failures = None, np.inf, 0, 0
+        if self.track.goal is not None:
+            self.blacklist.append(self.track.goal.copy())
+        self.track = GoalTrack()
 
     # ------------------------------------------------------------------ decision
     def decide(self, odom) -> np.ndarray | None:
@@ -414,16 +440,16 @@ class FrontierExplorer(BaselinePolicy):
                 self.done = True
                 return None
             best = min(ok, key=lambda fr: fr.cost)
-            if self.goal is None or np.hypot(*(best.goal - self.goal)) > cfg.blacklist_radius:
-                self.goal, self.best_progress, self.stuck_steps, self.failures = best.goal, best.path_m, 0, 0
+            if self.track.goal is None or np.hypot(*(best.goal - self.track.goal)) > cfg.blacklist_radius:
+                self.track = GoalTrack(best.goal, best.path_m)
             else:
-                self.goal = best.goal
-                if best.path_m < self.best_progress - 0.1:
-                    self.best_progress, self.stuck_steps = best.path_m, 0
+                self.track.goal = best.goal
+                if best.path_m < self.track.best - 0.1:
+                    self.track.best, self.track.stuck = best.path_m, 0
                 else:
-                    self.stuck_steps += 1
+                    self.track.stuck += 1
             at_goal = np.hypot(*(robot - best.goal)) < cfg.goal_tolerance
-            if self.stuck_steps >= cfg.progress_timeout or self.failures >= cfg.max_failures or at_goal:
+            if self.track.stuck >= cfg.progress_timeout or self.track.failures >= cfg.max_failures or at_goal:
                 self._blacklist_goal()
                 continue
             return self._waypoint(robot, best.goal)
@@ -432,7 +458,7 @@ class FrontierExplorer(BaselinePolicy):
 
     def _waypoint(self, robot, goal) -> np.ndarray:
         cfg, m = self.cfg, self.map
-        pred, blocked, (r0, c0) = self._plan
+        pred, blocked, (r0, c0), _ = self._plan
         f = cfg.plan_factor
         g = m.to_cell(goal) - np.array([r0, c0])
         path = extract_path(pred, blocked.shape, (g[0] // f, g[1] // f))

@@ -40,7 +40,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .frontier import FrontierConfig, FrontierExplorer
+from .frontier import FrontierConfig, FrontierExplorer, GoalTrack
 
 
 @dataclass(frozen=True)
@@ -83,11 +83,9 @@ class FrontierPaperExplorer(FrontierExplorer):
 
     def __init__(self, config: FrontierPaperConfig | None = None):
         super().__init__(config or FrontierPaperConfig())
-        self.best_distance = np.inf
-        self.plan_failures = 0  # decisions without any plan to the goal
-        self.failed_moves = 0
-        self.waits = 0  # decisions waiting at a reached goal whose frontier persists
-        self.pushes = 0  # decisions driving straight at a goal the plan could not reach
+        # decisions without any plan to the goal, failed moves, decisions waiting at a reached goal
+        # whose frontier persists, decisions driving straight at a goal the plan could not reach
+        self.stats = {"plan_failures": 0, "failed_moves": 0, "waits": 0, "pushes": 0}
 
     def observe(self, odom, ranges, angles, moved: bool | None) -> None:
         """As the parent, but failures toward a goal accumulate (a successful move does not reset them).
@@ -103,21 +101,19 @@ class FrontierPaperExplorer(FrontierExplorer):
         moved : bool or None
             Outcome of the last move.
         """
-        before = self.failures
+        before = self.track.failures
         super().observe(odom, ranges, angles, moved)
         if moved is False:
-            self.failed_moves += 1
+            self.stats["failed_moves"] += 1
         elif moved:
-            self.failures = before
+            self.track.failures = before
 
     def _reset_goal(self, goal) -> None:
-        self.goal = None if goal is None else np.asarray(goal, float).copy()
-        self.best_distance, self.stuck_steps, self.failures = np.inf, 0, 0
+        self.track = GoalTrack(None if goal is None else np.asarray(goal, float).copy())
 
     def _blacklist_goal(self) -> None:
-        if self.goal is not None:
-            self.blacklist.append(self.goal.copy())
-            self.blacklisted += 1
+        if self.track.goal is not None:
+            self.blacklist.append(self.track.goal.copy())
         self._reset_goal(None)
 
     def plan_target(self, goal) -> tuple[np.ndarray, float] | None:
@@ -137,8 +133,7 @@ class FrontierPaperExplorer(FrontierExplorer):
             ``(target (2,) metres, path length in metres)``, or None when no plan exists.
         """
         cfg, m = self.cfg, self.map
-        pred, blocked, (r0, c0) = self._plan
-        dist = self._dist
+        pred, blocked, (r0, c0), dist = self._plan
         f, res = cfg.plan_factor, cfg.resolution
         g = (m.to_cell(goal) - np.array([r0, c0])) // f
         H, W = blocked.shape
@@ -184,36 +179,36 @@ class FrontierPaperExplorer(FrontierExplorer):
                 self.done = True
                 return None
             best = min(ok, key=lambda fr: fr.cost)
-            if self.goal is None or np.hypot(*(best.centroid - self.goal)) > cfg.blacklist_radius:
+            if self.track.goal is None or np.hypot(*(best.centroid - self.track.goal)) > cfg.blacklist_radius:
                 self._reset_goal(best.centroid)
             else:
-                self.goal = best.centroid.copy()
-            if best.min_distance < self.best_distance - 1e-6:  # explore_lite's progress
-                self.best_distance, self.stuck_steps = best.min_distance, 0
+                self.track.goal = best.centroid.copy()
+            if best.min_distance < self.track.best - 1e-6:  # explore_lite's progress
+                self.track.best, self.track.stuck = best.min_distance, 0
             else:
-                self.stuck_steps += 1
-            if self.stuck_steps >= cfg.progress_timeout or self.failures >= cfg.max_failures:
+                self.track.stuck += 1
+            if self.track.stuck >= cfg.progress_timeout or self.track.failures >= cfg.max_failures:
                 self._blacklist_goal()
                 continue
-            target = self.plan_target(self.goal)
+            target = self.plan_target(self.track.goal)
             if target is None:  # no plan: a failed attempt; Nav2 recovers in place
-                self.failures += 1
-                self.plan_failures += 1
-                if self.failures >= cfg.max_failures:
+                self.track.failures += 1
+                self.stats["plan_failures"] += 1
+                if self.track.failures >= cfg.max_failures:
                     self._blacklist_goal()
                     continue
                 return robot.copy()
             xy, _ = target
             if np.hypot(*(robot - xy)) >= cfg.goal_tolerance:
                 return self._waypoint(robot, xy)
-            to_goal = self.goal - robot
+            to_goal = self.track.goal - robot
             gap = float(np.hypot(*to_goal))
             if gap < cfg.goal_tolerance:  # arrived; the frontier persists: wait (until the timeout)
-                self.waits += 1
+                self.stats["waits"] += 1
                 return robot.copy()
             # the plan ended short of a goal in an obstacle's inflation or cut off: the controller
             # still drives at the goal (a failed move when something is in the way)
-            self.pushes += 1
+            self.stats["pushes"] += 1
             step = min(cfg.step_length, gap)
             self.last_heading = float(np.arctan2(to_goal[1], to_goal[0]))
             return robot + step * to_goal / gap

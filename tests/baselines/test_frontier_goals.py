@@ -74,7 +74,7 @@ def test_paper_variant_sends_the_centroid_the_other_the_nearest_reachable_cell()
     ours.decide(ROBOT)
     blocked = ours._plan[1]
     g = (ours.map.to_cell(ours.goal) - np.array(ours._plan[2])) // ours.cfg.plan_factor
-    assert not blocked[g[0], g[1]] and np.isfinite(ours._dist[g[0], g[1]])  # a reachable planning cell
+    assert not blocked[g[0], g[1]] and np.isfinite(ours._plan[3][g[0], g[1]])  # a reachable planning cell
 
 
 def test_a_goal_that_fails_n_times_is_never_chosen_again():
@@ -88,7 +88,7 @@ def test_a_goal_that_fails_n_times_is_never_chosen_again():
     for moved in outcomes:
         pol.observe(ROBOT, None, None, moved)
         pol.decide(ROBOT)
-    assert pol.failures < cfg.max_failures and pol.blacklisted == 1
+    assert pol.track.failures < cfg.max_failures and pol.blacklisted == 1
     assert any(np.hypot(*(b - first)) < 1e-9 for b in pol.blacklist)
     chosen = [pol.goal.copy()]
     for _ in range(30):
