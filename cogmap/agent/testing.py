@@ -9,6 +9,8 @@ and boxes.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .aimapp import AIMAPPAgent, Decision, Sensed
@@ -40,27 +42,45 @@ class CellEncoder:
         return self.ids[key], new
 
 
+class BoxRoom(NamedTuple):
+    """The static side of a :class:`BoxWorld`: its extent, boxes (visible and hidden), the robot's
+    radius, step, headings and odometry slip."""
+
+    size: np.ndarray
+    boxes: list
+    hidden: list  # block motion, unseen by the sensor
+    radius: float
+    step_length: float
+    num_headings: int
+    slip: float
+
+
 class BoxWorld:
     """Rectangle ``[0, width] x [0, height]`` with axis-aligned boxes ``(x0, y0, x1, y1)``."""
 
     def __init__(self, width: float = 6.0, height: float = 6.0, boxes=(), start=(1.0, 1.0), slip: float = 0.0,
                  robot_radius: float = 0.22, step: float = 1.0, num_headings: int = 12, hidden=()):
-        self.size = np.array([width, height], dtype=float)
-        self.boxes = [tuple(map(float, b)) for b in boxes]
-        self.hidden = [tuple(map(float, b)) for b in hidden]  # block motion, unseen by the sensor
+        self.room = BoxRoom(np.array([width, height], dtype=float), [tuple(map(float, b)) for b in boxes],
+                            [tuple(map(float, b)) for b in hidden], robot_radius, step, num_headings, slip)
         self.true = np.array(start, dtype=float)
         self.odom = self.true.copy()
-        self.slip = slip
-        self.radius = robot_radius
-        self.step_length = step
-        self.num_headings = num_headings
         self.path = [self.true.copy()]
         self.dropped: set[int] = set()  # step numbers at which every sensor is silent
         self.steps = 0
 
+    @property
+    def boxes(self) -> list:
+        """The visible boxes (a list: a test may add one)."""
+        return self.room.boxes
+
+    @property
+    def size(self) -> np.ndarray:
+        """``(width, height)``, metres."""
+        return self.room.size
+
     def free(self, xy, boxes=None) -> bool:
         x, y = xy
-        r = self.radius
+        r = self.room.radius
         if not (r <= x <= self.size[0] - r and r <= y <= self.size[1] - r):
             return False
         boxes = self.boxes if boxes is None else boxes
@@ -70,8 +90,8 @@ class BoxWorld:
         return all(self.free(a + t * (b - a), boxes) for t in np.linspace(0.0, 1.0, n))
 
     def obstacles(self) -> np.ndarray:
-        h = 2 * np.pi * np.arange(self.num_headings) / self.num_headings
-        ends = self.true + self.step_length * np.stack([np.cos(h), np.sin(h)], axis=1)
+        h = 2 * np.pi * np.arange(self.room.num_headings) / self.room.num_headings
+        ends = self.true + self.room.step_length * np.stack([np.cos(h), np.sin(h)], axis=1)
         return np.array([not self.segment_free(self.true, e) for e in ends])
 
     def sense(self, moved: bool | None) -> Sensed:
@@ -86,10 +106,10 @@ class BoxWorld:
             return True
         delta = np.asarray(decision.waypoint, dtype=float) - self.odom
         target = self.true + delta
-        ok = self.segment_free(self.true, target, boxes=self.boxes + self.hidden)
+        ok = self.segment_free(self.true, target, boxes=self.room.boxes + self.room.hidden)
         if ok:
             self.true = target
-            self.odom = self.odom + delta * (1.0 + self.slip)
+            self.odom = self.odom + delta * (1.0 + self.room.slip)
         self.path.append(self.true.copy())
         return ok
 
