@@ -6,7 +6,17 @@ import warnings
 from dataclasses import asdict, dataclass, field, fields
 
 from cogmap.inference.learning import LearningRates
+from cogmap.planning.mcts import MCTSConfig
 from cogmap.planning.sensed import check_bounds
+
+#: AIMAPP's MCTS: depth 10, 30 simulations (Appendix A.3, Table 6), policy precision 8 (Eq. 4); a move
+#: is planned only when it is believed to leave the state with probability above 0.1
+AIMAPP_MCTS = MCTSConfig(depth=10, simulations=30, gamma=8.0, move_threshold=0.1)
+#: the names of MCTSConfig's fields in an AgentConfig file (the others: ``mcts_<field>``)
+_MCTS_KEYS = {"depth": "mcts_depth", "simulations": "mcts_simulations", "gamma": "gamma",
+              "move_threshold": "min_move_probability", "count_information_once": "mcts_count_information_once",
+              "discount": "mcts_discount"}
+_MCTS_DEFAULT = MCTSConfig()
 
 
 @dataclass(frozen=True)
@@ -56,33 +66,24 @@ class AgentConfig:
         sparse model (:func:`cogmap.inference.accepting`: ``"exact"``, ``"filter"``, ``"fpi"``,
         ``"vmp"``, ``"mmp"`` or one of yours); ``"filter"``, the exact Bayes filter of the paper, by
         default.
-    mcts_depth : int
-        Steps of the MCTS lookahead (Appendix A.3 and Table 6: 10).
-    mcts_simulations : int
-        MCTS simulations per decision (Appendix A.3 and Table 6: 30).
-    mcts_count_information_once : bool
-        Count epistemic value once per imagined path in MCTS (see
-        :class:`cogmap.planning.mcts.MCTSConfig`); False sums every step's EFE as in Eq. (5).
-    mcts_discount : float
-        Discount of later steps' EFE in MCTS; 1 is the plain sum of Eq. (5).
+    mcts : cogmap.planning.mcts.MCTSConfig
+        The planner's settings, used as they are (:data:`AIMAPP_MCTS`: depth 10 and 30 simulations,
+        Appendix A.3 and Table 6; policy precision ``gamma`` 8, Eq. 4; a move is planned only when
+        it is believed to leave the state with probability above ``move_threshold`` 0.1). In files
+        (:meth:`to_dict`) its fields read ``mcts_depth``, ``mcts_simulations``, ``gamma``,
+        ``min_move_probability``, ``mcts_<field>`` for the others.
     z_threshold : float
         Nats. Threshold of the confidence test (A.1.2 uses 4): the agent is confident when the
         log-odds of its most likely state against the runner-up reach it, and lost when the CUSUM
         of the observation conflict does (:mod:`cogmap.agent.confidence`).
     goal_weight : float
         Weight of the preference on the goal observation in goal mode (section 4.4).
-    gamma : float
-        Policy precision (Eq. 4): precision of the softmax over the MCTS root values
-        (``MCTSConfig.gamma``).
     pose_sigma : float or None
         Metres. Width of the pose likelihood A_p and of the Eq. (7) kernel; None means
         ``influence_radius / 3`` (see :attr:`sigma`).
     obstacle_margin : float
         Metres added to ``robot_radius`` for the half-width of the collision corridor of a move
         (also passed to the simulator's own obstacle signal by :mod:`cogmap.explore`).
-    min_move_probability : float
-        MCTS plans a move only when the believed probability that it leaves the current state
-        exceeds this (``MCTSConfig.move_threshold``).
     inductive_threshold : float
         A transition counts as possible for the inductive term H when its probability in B_s
         exceeds this (Eq. 9, A.2); the same graph gives the path lengths of the goal study.
@@ -197,16 +198,11 @@ class AgentConfig:
     ssim_threshold: float = 0.65  # place recognition (Table 6)
     encoder: str = "ssim"  # observation encoder by name (cogmap.agent.encoder.register_encoder)
     scheme: str = "filter"  # inference scheme by name (cogmap.inference.register); the paper's: filter
-    mcts_depth: int = 10  # Appendix A.3
-    mcts_simulations: int = 30
-    mcts_count_information_once: bool = False  # Eq. 5 sums every step's EFE (see MCTSConfig)
-    mcts_discount: float = 1.0
+    mcts: MCTSConfig = AIMAPP_MCTS  # the planner's settings, embedded (Appendix A.3, Table 6, Eq. 4)
     z_threshold: float = 4.0  # confidence test (A.1.2), in nats of log-odds
     goal_weight: float = 10.0  # preference weight on the goal observation (section 4.4)
-    gamma: float = 8.0  # policy precision (Eq. 4)
     pose_sigma: float | None = None  # width of the pose likelihood; default influence_radius / 3
     obstacle_margin: float = 0.1  # a direction is blocked when the sector's range < step + margin
-    min_move_probability: float = 0.1  # a move is planned only if it is believed to leave the state
     inductive_threshold: float = 0.5  # transitions believed possible above this (Eq. 9)
     inductive_depth: int = 60  # steps over which H propagates goal value back (beyond the MCTS depth)
     inductive_weight: float = 1.0
@@ -281,16 +277,7 @@ class AgentConfig:
             ``view_bounds`` when None (so manifests and study run keys made before these fields
             existed stay the same; :meth:`from_dict` restores them).
         """
-        d = asdict(self)
-        if d["view_bounds"] is None:  # likewise: runs that know no outline keep their keys
-            del d["view_bounds"]
-        if d["scheme"] == "filter":  # the paper's scheme is implicit too: earlier run keys stay valid
-            del d["scheme"]
-        if d["encoder"] == "ssim":
-            # the paper's encoder is left implicit (from_dict restores it), so the manifests and
-            # study run keys of runs made before encoders were chosen by name stay the same
-            del d["encoder"]
-        return d
+        return _to_dict(self)
 
     @classmethod
     def from_dict(cls, d: dict) -> AgentConfig:
@@ -313,69 +300,118 @@ class AgentConfig:
             On a key that is not a field (of the config or of the learning rates), or a
             ``scheme`` that names no registered inference scheme.
         """
-        d = dict(d)
-        for key in _RETIRED & set(d):  # settings of earlier versions that no longer change a run
-            warnings.warn(f"AgentConfig: field {key!r} is retired and ignored", stacklevel=2)
-            del d[key]
-        _check_keys(cls, d)
-        if isinstance(d.get("learning"), dict):
-            lr = dict(d["learning"])
-            _check_keys(LearningRates, lr)
-            d["learning"] = LearningRates(**{k: tuple(v) if isinstance(v, list) else v for k, v in lr.items()})
-        if "scheme" in d:  # a name read from a file only selects among the schemes registered in this process
-            from cogmap import inference
+        return cls(**_from_dict(d))
 
-            if d["scheme"] not in inference.available():
-                raise ValueError(f"AgentConfig.scheme: {d['scheme']!r} is not a registered inference scheme "
-                                 f"(registered: {', '.join(inference.available())}; add yours with --plugin)")
-        return cls(**d)
+
+def _to_dict(cfg) -> dict:
+    """``cfg`` as plain data (see ``AgentConfig.to_dict``)."""
+    d = asdict(cfg)
+    del d["mcts"]
+    for f in fields(MCTSConfig):  # the planner's settings, flat as in files made before they were nested
+        key, v = _MCTS_KEYS.get(f.name, f"mcts_{f.name}"), getattr(cfg.mcts, f.name)
+        if f.name in _MCTS_KEYS or v != getattr(_MCTS_DEFAULT, f.name):
+            d[key] = v
+    if d["view_bounds"] is None:  # likewise: runs that know no outline keep their keys
+        del d["view_bounds"]
+    if d["scheme"] == "filter":  # the paper's scheme is implicit too: earlier run keys stay valid
+        del d["scheme"]
+    if d["encoder"] == "ssim":
+        # the paper's encoder is left implicit (from_dict restores it), so the manifests and
+        # study run keys of runs made before encoders were chosen by name stay the same
+        del d["encoder"]
+    return d
+
+
+def _from_dict(d: dict) -> dict:
+    """The keyword arguments of :class:`AgentConfig` from a file's dict (see ``from_dict``)."""
+    d = dict(d)
+    for key in _RETIRED & set(d):  # settings of earlier versions that no longer change a run
+        warnings.warn(f"AgentConfig: field {key!r} is retired and ignored", stacklevel=3)
+        del d[key]
+    mcts = {f.name: d.pop(_MCTS_KEYS.get(f.name, f"mcts_{f.name}")) for f in fields(MCTSConfig)
+            if _MCTS_KEYS.get(f.name, f"mcts_{f.name}") in d}
+    _check_keys(AgentConfig, d)
+    if isinstance(d.get("mcts"), dict):  # nested, as asdict writes it
+        _check_keys(MCTSConfig, d["mcts"])
+        mcts = d.pop("mcts") | mcts
+    if mcts:
+        d["mcts"] = MCTSConfig(**{f.name: getattr(AIMAPP_MCTS, f.name) for f in fields(MCTSConfig)} | mcts)
+    if isinstance(d.get("learning"), dict):
+        lr = dict(d["learning"])
+        _check_keys(LearningRates, lr)
+        d["learning"] = LearningRates(**{k: tuple(v) if isinstance(v, list) else v for k, v in lr.items()})
+    if "scheme" in d:  # a name read from a file only selects among the schemes registered in this process
+        from cogmap import inference
+
+        if d["scheme"] not in inference.available():
+            raise ValueError(f"AgentConfig.scheme: {d['scheme']!r} is not a registered inference scheme "
+                             f"(registered: {', '.join(inference.available())}; add yours with --plugin)")
+    return d
 
 
 _RETIRED = frozenset({"view_frontier_reach"})
 
 
-def _check_values(cfg) -> None:
-    """Refuse a field of the wrong type or a non-finite number, naming the field (``AgentConfig.x``);
-    the nested learning rates too (``AgentConfig.learning.x``)."""
+def _number(v) -> bool:
+    import numpy as np
+
+    return not isinstance(v, bool | np.bool_) and isinstance(v, int | float | np.integer | np.floating)
+
+
+def _bad(name: str, v, expected: str):
+    raise ValueError(f"AgentConfig.{name}: expected {expected}, got {v!r}")
+
+
+def _check_one(v, kind: str, name: str) -> None:
+    """Refuse ``v`` unless it is of the field's ``kind`` (bool, int, float, optional float, str)."""
     import math
 
     import numpy as np
 
-    def number(v) -> bool:
-        return not isinstance(v, bool | np.bool_) and isinstance(v, int | float | np.integer | np.floating)
+    if kind == "bool":
+        if not isinstance(v, bool | np.bool_):
+            _bad(name, v, "true or false")
+    elif kind == "int":
+        if isinstance(v, bool | np.bool_) or not isinstance(v, int | np.integer):
+            _bad(name, v, "an integer")
+    elif kind in ("float", "float | None"):
+        if v is None and kind == "float | None":
+            return
+        if not _number(v) or not math.isfinite(v):
+            _bad(name, v, "a finite number" + (" or None" if kind != "float" else ""))
+    elif kind == "str":
+        if not isinstance(v, str):
+            _bad(name, v, "a string")
+        if name in ("scheme", "encoder") and not v:
+            _bad(name, v, "a non-empty string")
 
-    def bad(name: str, v, expected: str):
-        raise ValueError(f"AgentConfig.{name}: expected {expected}, got {v!r}")
+
+def _check_values(cfg) -> None:
+    """Refuse a field of the wrong type or a non-finite number, naming the field (``AgentConfig.x``);
+    the nested learning rates too (``AgentConfig.learning.x``), and the MCTS settings by their names
+    in files (``AgentConfig.mcts_depth``, ``AgentConfig.gamma``, ...)."""
+    import math
 
     for f in fields(cfg):
-        v, kind, name = getattr(cfg, f.name), str(f.type), f.name
+        v, name = getattr(cfg, f.name), f.name
         if name == "view_bounds":
             continue  # checked by check_bounds
-        if name == "learning":
+        if name == "mcts":
+            if not isinstance(v, MCTSConfig):
+                _bad(name, v, "MCTSConfig")
+            for g in fields(v):
+                if str(g.type) in ("bool", "int", "float"):
+                    _check_one(getattr(v, g.name), str(g.type), _MCTS_KEYS.get(g.name, f"mcts_{g.name}"))
+        elif name == "learning":
             if not isinstance(v, LearningRates):
-                bad(name, v, "LearningRates")
+                _bad(name, v, "LearningRates")
             for g in fields(v):
                 w = getattr(v, g.name)
                 items = w if isinstance(w, tuple) else (w,)
-                if not items or not all(number(x) and math.isfinite(x) for x in items):
-                    bad(f"learning.{g.name}", w, "finite numbers" if isinstance(w, tuple) else "a finite number")
-            continue
-        if kind == "bool":
-            if not isinstance(v, bool | np.bool_):
-                bad(name, v, "true or false")
-        elif kind == "int":
-            if isinstance(v, bool | np.bool_) or not isinstance(v, int | np.integer):
-                bad(name, v, "an integer")
-        elif kind in ("float", "float | None"):
-            if v is None and kind == "float | None":
-                continue
-            if not number(v) or not math.isfinite(v):
-                bad(name, v, "a finite number" + (" or None" if kind != "float" else ""))
-        elif kind == "str":
-            if not isinstance(v, str):
-                bad(name, v, "a string")
-            if name in ("scheme", "encoder") and not v:
-                bad(name, v, "a non-empty string")
+                if not items or not all(_number(x) and math.isfinite(x) for x in items):
+                    _bad(f"learning.{g.name}", w, "finite numbers" if isinstance(w, tuple) else "a finite number")
+        else:
+            _check_one(v, str(f.type), name)
 
 
 def _check_keys(cls, d: dict) -> None:

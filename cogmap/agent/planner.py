@@ -9,7 +9,6 @@ from cogmap.planning import inductive as ind
 from cogmap.planning.arrays import from_model, prepare
 from cogmap.planning.context import LocalStep
 from cogmap.planning.decide import decide as mcts_decide
-from cogmap.planning.mcts import MCTSConfig
 
 
 def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
@@ -85,9 +84,7 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     cfg, model = agent.cfg, agent.model
     n = model.num_states[0]
     obstacles = np.asarray(obstacles, dtype=bool)
-    mcfg = MCTSConfig(depth=cfg.mcts_depth, simulations=cfg.mcts_simulations, gamma=cfg.gamma,
-                      move_threshold=cfg.min_move_probability, count_information_once=cfg.mcts_count_information_once,
-                      discount=cfg.mcts_discount)
+    mcfg = cfg.mcts
     view = None
     if mode == "goal":  # preferences C (set by the agent's goal) weighted 10, inductive term, collision
         objective = efe.goal(goal_weight=cfg.goal_weight, inductive_weight=cfg.inductive_weight)

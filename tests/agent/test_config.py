@@ -11,6 +11,7 @@ from cogmap.agent.aimapp import AIMAPPAgent
 from cogmap.agent.config import AgentConfig
 from cogmap.agent.testing import BoxWorld, CellEncoder, run
 from cogmap.inference.learning import LearningRates
+from cogmap.planning.mcts import MCTSConfig
 
 
 def _other(value):
@@ -32,7 +33,10 @@ def _other(value):
 
 def test_round_trip_keeps_every_field_through_json():
     base = AgentConfig()
-    changed = {f.name: _other(getattr(base, f.name)) for f in fields(AgentConfig) if f.name != "learning"}
+    changed = {f.name: _other(getattr(base, f.name)) for f in fields(AgentConfig) if f.name not in ("learning", "mcts")}
+    # the planner's settings, every one changed (share and backup to their other choice)
+    changed["mcts"] = MCTSConfig(**{f.name: _other(getattr(base.mcts, f.name)) for f in fields(MCTSConfig)
+                                    if f.name not in ("share", "backup")}, share="state", backup="mean")
     changed["view_bounds"] = (-1.0, -2.0, 3.0, 4.0)  # an outline, not any value
     changed["scheme"] = "fpi"  # another registered scheme (a file may name only registered ones)
     lr = LearningRates(**{f.name: _other(getattr(base.learning, f.name)) for f in fields(LearningRates)})
@@ -59,9 +63,9 @@ def test_unknown_fields_are_refused_by_name():
 
 @pytest.mark.parametrize("kwargs, message", [
     (dict(collision_preference=float("nan")), "AgentConfig.collision_preference: expected a finite number, got nan"),
-    (dict(gamma=float("inf")), "AgentConfig.gamma: expected a finite number, got inf"),
+    (dict(mcts=MCTSConfig(gamma=float("inf"))), "AgentConfig.gamma: expected a finite number, got inf"),
     (dict(pose_sigma=float("nan")), "AgentConfig.pose_sigma: expected a finite number or None, got nan"),
-    (dict(mcts_depth=2.5), "AgentConfig.mcts_depth: expected an integer, got 2.5"),
+    (dict(mcts=MCTSConfig(depth=2.5)), "AgentConfig.mcts_depth: expected an integer, got 2.5"),
     (dict(view_weighting="yes"), "AgentConfig.view_weighting: expected true or false, got 'yes'"),
     (dict(encoder=3), "AgentConfig.encoder: expected a string, got 3"),
     (dict(learning=LearningRates(floor=float("nan"))), "AgentConfig.learning.floor: expected a finite number"),
@@ -73,6 +77,9 @@ def test_non_finite_or_mistyped_values_are_refused_naming_the_field(kwargs, mess
         AgentConfig(**kwargs)
     assert str(err.value).startswith(message)
     key, value = next(iter(kwargs.items()))
+    if key == "mcts":  # in a manifest the planner's settings are flat: mcts_depth, gamma, ...
+        key = message.split(":")[0].removeprefix("AgentConfig.")
+        value = value.gamma if key == "gamma" else value.depth
     if key != "learning":  # the same from a manifest (JSON keeps NaN as NaN)
         with pytest.raises(ValueError, match="AgentConfig." + key):
             AgentConfig.from_dict(json.loads(json.dumps({key: value})))
