@@ -1,4 +1,5 @@
-"""The hierarchical active-inference drone: agent shell, baselines, episodes and runs.
+"""The hierarchical active-inference drone: agent shell, episodes and runs (its baselines are in
+:mod:`cogmap.planning.drone_policies`, its voxel memory in :mod:`cogmap.genmodel.voxel_map`).
 
 The maths lives in the libraries: suitability and binned factors in ``cogmap.genmodel``
 (:mod:`~cogmap.genmodel.suitability`, :mod:`~cogmap.genmodel.drone_beliefs`), the Gaussian-kernel
@@ -7,11 +8,7 @@ belief update as the ``"kernel"`` inference scheme, waypoint generation, filteri
 ``cogmap.envs`` (:mod:`~cogmap.envs.drone_sim`).
 """
 
-from cogmap.genmodel.voxel_map import VoxelMap
-from cogmap.planning.drone_policies import PotentialField, StraightLine
-
 from .agent import DroneAgent, DroneAgentConfig
 from .episode import EpisodeLimits, fly_episode, make_policy, summarise
 
-__all__ = ["DroneAgent", "DroneAgentConfig", "EpisodeLimits", "PotentialField", "StraightLine", "VoxelMap",
-           "fly_episode", "make_policy", "summarise"]
+__all__ = ["DroneAgent", "DroneAgentConfig", "EpisodeLimits", "fly_episode", "make_policy", "summarise"]

@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
-from cogmap.drone import DroneAgent, PotentialField, StraightLine, VoxelMap
+from cogmap.drone import DroneAgent
 from cogmap.drone.episode import make_policy
+from cogmap.genmodel.voxel_map import VoxelMap
+from cogmap.planning.drone_policies import PotentialField, StraightLine
 
 
 class _Scan:
