@@ -231,6 +231,68 @@ class ExploreResult:
 
 
 
+class MIAgent:
+    """The DVBF-LM agent's controls (Algorithm 1): the first controls of the best candidate of each
+    planning call on its own online SLAM, re-planned when they are used up or a wall stopped it.
+
+    Parameters
+    ----------
+    planner : MIPlanner
+        The planning call.
+    slam : OnlineSLAM
+        The agent's map and pose posterior (advanced by the episode, flushed here before a plan).
+    cfg : ExploreConfig
+        ``replan_every`` and ``train_every``.
+    rng : numpy.random.Generator
+        The candidates' generator.
+
+    Attributes
+    ----------
+    plan_seconds : list of float
+        Wall clock of each planning call.
+    pulled : int
+        Planning calls in which the frontier pull chose the controls.
+    """
+
+    def __init__(self, planner: MIPlanner, slam, cfg: ExploreConfig, rng: np.random.Generator):
+        self.planner, self.slam, self.cfg, self.rng = planner, slam, cfg, rng
+        self.queue: list[np.ndarray] = []
+        self.plan_seconds: list[float] = []
+        self.pulled = 0
+
+    def act(self, pose, scan, blocked: bool) -> np.ndarray:
+        """The next control (the same call as the baselines').
+
+        Parameters
+        ----------
+        pose : numpy.ndarray, shape (3,)
+            True pose (unused: the agent plans from its own posterior).
+        scan : numpy.ndarray, shape (n_beams,)
+            Current scan (unused here: the SLAM has it).
+        blocked : bool
+            Whether a wall stopped the last step: the plan ran into it, re-plan from here at once.
+
+        Returns
+        -------
+        numpy.ndarray, shape (2,)
+            ``(turn in rad, forward in maze units)``.
+        """
+        cfg = self.cfg
+        if blocked:
+            self.queue = []
+        if not self.queue:
+            self.slam.flush()  # plan from the latest pose posterior
+            t0 = time.perf_counter()
+            u_best, info = self.planner.plan(self.slam, self.rng)
+            self.plan_seconds.append(time.perf_counter() - t0)
+            self.pulled += int(info["pulled"])
+            # execute up to the predicted collision, rounded up to whole filter chunks (standing after it)
+            free = int(info["free_steps"][info["best"]])
+            n = min(cfg.replan_every, cfg.train_every * max(1, -(-free // cfg.train_every)))
+            self.queue = list(u_best[:n])
+        return self.queue.pop(0)
+
+
 def cache_dir():
     """Where the pretrained emission is kept between runs (``$XDG_CACHE_HOME/cogmap``, else ``~/.cache/cogmap``).
 
@@ -335,7 +397,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         pose = sim.reset(start_pose(maze, cfg.seed))
         scan = sim.lidar()
         poses, controls, scans = [pose], [], [scan]
-        slam = planner = None
+        slam = None
         use_slam = cfg.method == "mi" or cfg.learn_map
         if use_slam:
             from cogmap.genmodel.latent_map import kl_map
@@ -348,31 +410,18 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         if cfg.method == "mi":
             mi = cfg.mi if cfg.mi.max_step == cfg.max_step and cfg.mi.max_turn == cfg.max_turn else \
                 dataclasses.replace(cfg.mi, max_step=cfg.max_step, max_turn=cfg.max_turn)
-            planner = MIPlanner(model, mi, maze.size, cfg.seed, cfg.penalty_from)
-        policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
-                  else Frontier(maze, cfg, cfg.seed, sim.lidar_range) if cfg.method == "frontier" else None)
-        rng = np.random.default_rng([cfg.seed, 5])
-        ratio_curve, info_curve, plan_seconds = [(0, exploration_ratio(maze, pose))], [], []
+            policy = MIAgent(MIPlanner(model, mi, maze.size, cfg.seed, cfg.penalty_from), slam, cfg,
+                             np.random.default_rng([cfg.seed, 5]))
+        else:
+            policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
+                      else Frontier(maze, cfg, cfg.seed, sim.lidar_range))
+        ratio_curve, info_curve = [(0, exploration_ratio(maze, pose))], []
         tiles = {tuple(r) for r in maze.tile_index(pose)}
         if slam is not None:
             info_curve.append((0, float(kl_map(slam.params.q_map))))
-        queue: list[np.ndarray] = []
-        blocked = n_blocked = n_pulled = 0
+        blocked = n_blocked = 0
         for t in range(1, steps):
-            if planner is not None:
-                if not queue:
-                    slam.flush()  # plan from the latest pose posterior
-                    t0 = time.perf_counter()
-                    u_best, info = planner.plan(slam, rng)
-                    plan_seconds.append(time.perf_counter() - t0)
-                    n_pulled += int(info["pulled"])
-                    # execute up to the predicted collision, rounded up to whole filter chunks (standing after it)
-                    free = int(info["free_steps"][info["best"]])
-                    n = min(cfg.replan_every, cfg.train_every * max(1, -(-free // cfg.train_every)))
-                    queue = list(u_best[:n])
-                u = queue.pop(0)
-            else:
-                u = policy.act(pose, scan, bool(blocked))
+            u = policy.act(pose, scan, bool(blocked))
             pose, blocked = sim.step(u)
             scan = sim.lidar()
             n_blocked += int(blocked)
@@ -384,9 +433,6 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
                 # a bump sensor tells the agent that a wall stopped it: the filter then sees no translation
                 # (the distance moved before the wall is not known to it)
                 slam.advance(np.array([u[0], 0.0 if blocked else u[1]])[None], scan[None])
-            if blocked and planner is not None:
-                # the plan ran into a wall: re-plan from here at once (the filter takes the shorter chunk)
-                queue = []
             if t % cfg.curve_every == 0 or t == steps - 1:
                 ratio_curve.append((t, len(tiles) / maze.tiles**2))
                 if slam is not None and slam.t == t and t % (10 * cfg.curve_every) == 0:
@@ -400,7 +446,8 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
             if info_curve[-1][0] != steps - 1:
                 info_curve.append((steps - 1, float(kl_map(slam.params.q_map))))
         return ExploreResult(np.array(poses), np.array(controls), np.array(scans), est, ratio_curve, info_curve,
-                             plan_seconds, n_blocked, n_pulled, params=slam.params if slam else None,
+                             getattr(policy, "plan_seconds", []), n_blocked, getattr(policy, "pulled", 0),
+                             params=slam.params if slam else None,
                              model=slam.config.model if slam else None, seconds=time.perf_counter() - tic)
     finally:
         sim.close()
