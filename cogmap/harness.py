@@ -2,7 +2,8 @@
 
 The harness owns what is not the policy's business: the episode record (trajectory rows,
 coverage, distance, decision time), the LiDAR coverage of the run (ground truth, for the
-metrics), acting on the simulator and the stopping rules. A policy follows :class:`Policy`:
+metrics), acting on the simulator and the stopping rules. A policy follows :class:`Policy`
+(:class:`cogmap.genmodel.contracts.EpisodePolicy`):
 
 - ``sense(sim, moved)`` reads the sensors it is allowed (not timed; ``moved`` is the outcome of
   the last motion command, None before the first);
@@ -18,10 +19,11 @@ from __future__ import annotations
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import Any
 
 import numpy as np
 
+from cogmap.genmodel.contracts import EpisodePolicy as Policy
 from cogmap.metrics import CoverageTracker
 
 
@@ -81,48 +83,6 @@ class Command:
     done: bool = False
     status: dict = field(default_factory=dict)
     decision: Any = None
-
-
-@runtime_checkable
-class Policy(Protocol):
-    """What the harness needs of a policy (a runtime-checkable protocol).
-
-    Attributes
-    ----------
-    label : str
-        Progress-bar description.
-    """
-
-    label: str  # progress-bar description
-
-    def sense(self, sim, moved: bool | None) -> Any:
-        """What the policy senses this step (read from ``sim``, only the streams it may use).
-
-        Parameters
-        ----------
-        sim : NavSim
-            The simulator.
-        moved : bool or None
-            Whether the last motion command succeeded; None before the first.
-
-        Returns
-        -------
-        object
-            Whatever :meth:`step` expects.
-        """
-
-    def step(self, sensed) -> Command:
-        """Decide from what was sensed.
-
-        Parameters
-        ----------
-        sensed : object
-            The value :meth:`sense` returned.
-
-        Returns
-        -------
-        Command
-        """
 
 
 # The coverage of a simulator run is kept per simulator (runs that follow one another in one

@@ -180,6 +180,49 @@ class Study(Protocol):
     def report(self, study_dir, plan, results) -> str: ...
 
 
+@runtime_checkable
+class EpisodePolicy(Protocol):
+    """What the room episode runner (``cogmap.harness.run_episode``) needs of a policy (runtime-checkable).
+
+    Attributes
+    ----------
+    label : str
+        Progress-bar description.
+    """
+
+    label: str  # progress-bar description
+
+    def sense(self, sim, moved: bool | None) -> Any:
+        """What the policy senses this step (read from ``sim``, only the streams it may use).
+
+        Parameters
+        ----------
+        sim : NavSim
+            The simulator.
+        moved : bool or None
+            Whether the last motion command succeeded; None before the first.
+
+        Returns
+        -------
+        object
+            Whatever :meth:`step` expects.
+        """
+
+    def step(self, sensed) -> Any:
+        """Decide from what was sensed.
+
+        Parameters
+        ----------
+        sensed : object
+            The value :meth:`sense` returned.
+
+        Returns
+        -------
+        Command
+            A ``cogmap.harness.Command``.
+        """
+
+
 def _members(protocol) -> dict[str, object]:
     """The protocol's own methods and data members (its bases' included), name -> declaration."""
     out: dict[str, object] = {}
