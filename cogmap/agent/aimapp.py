@@ -416,7 +416,7 @@ class AIMAPPAgent:
         views = self.memory.views
         views.pursuit.blind = sensed.scan is None
         if not self.belief.lost and sensed.scan is not None:  # what the LiDAR swept, through the corrected frame
-            views.observe(self, sensed)
+            views.observe(self.frame, sensed)
             if conf.confident:
                 self.memory.scanned.add(int(np.argmax(self.q)))
         decision = self._decide(local, pose, conf, expanded)

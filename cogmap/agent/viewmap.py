@@ -8,6 +8,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from cogmap.inference.se2 import apply, rotate
 from cogmap.planning import sensed as sg
 
 
@@ -68,21 +69,16 @@ class ViewMap:
         cfg = self.cfg
         return _full_area(cfg.view_radius, cfg.view_rays, cfg.view_resolution, cfg.view_free_path)
 
-    def observe(self, agent, sensed) -> None:
+    def observe(self, frame, sensed) -> None:
         """Add the scan of ``sensed`` (points relative to the robot, odometry frame) to the grid,
-        through the agent's own odometry -> belief mapping."""
+        through the odometry -> belief transform ``frame`` (:class:`cogmap.inference.se2.SE2`)."""
         scan = sensed.scan
         if scan is None or sensed.odometry is None:
             return
-        odom = np.asarray(sensed.odometry, dtype=float)
-        robot = agent.believed_pose(odom)
-        # the agent's odometry -> belief mapping, read at two unit offsets (exact for any affine,
-        # e.g. rigid, correction), applied to the returns
-        ex = agent.believed_pose(odom + np.r_[1.0, 0.0, np.zeros(odom.size - 2)]) - robot
-        ey = agent.believed_pose(odom + np.r_[0.0, 1.0, np.zeros(odom.size - 2)]) - robot
+        robot = apply(frame, np.asarray(sensed.odometry, dtype=float)[:2])
+
         def belief(rel):
-            rel = np.asarray(rel, dtype=float).reshape(-1, 2)
-            return robot + rel[:, :1] * ex + rel[:, 1:] * ey
+            return robot + rotate(frame, np.asarray(rel, dtype=float).reshape(-1, 2))
 
         pts = belief(scan)
         if self.grid is None:

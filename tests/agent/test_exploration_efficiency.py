@@ -73,13 +73,14 @@ def test_scan_goes_through_the_agents_pose_mapping_even_when_it_rotates():
     from cogmap.agent.aimapp import Sensed
     from cogmap.agent.config import AgentConfig
     from cogmap.agent.viewmap import ViewMap
+    from cogmap.inference.se2 import SE2
     from cogmap.planning import sensed as sg
 
     agent = _RigidAgent(np.pi / 2, (5.0, -1.0))
     views = ViewMap(AgentConfig())
     odom = np.array([1.0, 2.0, 0.3])
     scan = np.array([[2.0, 0.0], [0.0, -1.5]])  # returns relative to the robot, odometry frame
-    views.observe(agent, Sensed(None, None, odom, None, scan))
+    views.observe(SE2(np.pi / 2, 5.0, -1.0), Sensed(None, None, odom, None, scan))  # the same rigid map
     expected = np.array([agent.believed_pose(odom[:2] + p) for p in scan])
     np.testing.assert_allclose(views.returns, expected, atol=1e-12)
     rc = sg.to_cells(views.grid, expected)
