@@ -425,7 +425,6 @@ class AIMAPPAgent:
         self.belief = self.belief._replace(outcome=None)
         return decision
 
-    # -- the cycle -------------------------------------------------------------------------
     def _record_frame_move(self, kind: str, before, odometry) -> None:
         moved = float(np.hypot(*(self.believed_pose(odometry) - np.asarray(before)[:2])))
         self.memory.frame_moves.append({"step": self.counts.steps, "kind": kind, "moved_m": moved})
@@ -452,8 +451,9 @@ class AIMAPPAgent:
         if self.belief.lost:  # the graph cannot guide a move: a free direction, seeking familiar views
             action, to = wander(cfg, self.rng, sensed.obstacles, pose)
             return Decision(action, self.to_odometry(to), state, state, "relocalise", conf, expanded)
-        mode = "goal" if self.goal_obs is not None else "explore"
+        mode, goals = ("goal", self.goal_states()) if self.goal_obs is not None else ("explore", None)
         flags = move_obstacles(self.model, cfg, self.memory.traversed, state, sensed.obstacles, sensed.scan, pose)
-        action, efe = planner.decide(self, state, flags, mode)
+        action, efe = planner.decide(self.model, cfg, self.q, self.rng, self.memory.views, self.scanned_from(), goals,
+                                     state, flags, mode)
         target, to = waypoint(self.model, cfg, state, action)
         return Decision(action, self.to_odometry(to), state, target, mode, conf, expanded, efe)

@@ -11,7 +11,7 @@ from cogmap.planning.context import LocalStep
 from cogmap.planning.decide import decide as mcts_decide
 
 
-def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
+def _target(model, cfg, views, seen_from: np.ndarray, state: int, areas: np.ndarray) -> np.ndarray:
     """The preferred state of the inductive term while exploring (docs/exploration.md).
 
     Viewpoints are the informative unvisited states and frontier points (``ViewMap.viewpoints``),
@@ -26,9 +26,9 @@ def _target(agent, state: int, areas: np.ndarray) -> np.ndarray:
     nothing is set aside while the LiDAR is silent, since the map cannot grow then), as the oracle's viewpoints
     are once stood on. Empty when no viewpoint is left or none is brought nearer; then
     ``views.pursuit.unreached`` counts the viewpoints and the paper's terms alone decide."""
-    cfg, views, B, n = agent.cfg, agent.memory.views, agent.model.B[0], agent.num_states
+    B, n = model.B[0], model.num_states[0]
     aim = views.pursuit
-    poses, visited = agent.poses[:n], agent.scanned_from()[:n].astype(bool)
+    poses, visited = model.pose.poses[:n], np.asarray(seen_from[:n], dtype=bool)
     xy, gains = views.viewpoints(poses, visited, areas)
     src, dst = B.edges(cfg.inductive_threshold, n)
     doubt = views.doubtful(poses, src, dst, state)
@@ -79,22 +79,53 @@ def _revive(spent: list, new_poses, margin: float) -> list:
     return [(p, near) for p, near in spent if np.hypot(*(new_poses - p).T).min() >= near - margin]
 
 
-def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
-    """Return (control, summary) for the agent's current belief ``agent.q``."""
-    cfg, model = agent.cfg, agent.model
+def decide(model, cfg, q: np.ndarray, rng: np.random.Generator, views, seen_from: np.ndarray, goals, state: int,
+           obstacles, mode: str) -> tuple[int, dict]:
+    """One MCTS decision over expected free energy (Appendix A.3), exploring or in goal mode.
+
+    Parameters
+    ----------
+    model : cogmap.genmodel.Model
+        The map.
+    cfg : AgentConfig
+        The agent's parameters (``cfg.mcts`` goes to the search as it is).
+    q : numpy.ndarray
+        ``(num_states,)`` current belief.
+    rng : numpy.random.Generator
+        The search's generator.
+    views : ViewMap
+        What the LiDAR has sensed (exploration's view weighting and target).
+    seen_from : numpy.ndarray
+        ``(num_states,)`` bool: states stood on with the LiDAR reporting.
+    goals : numpy.ndarray or None
+        Goal states in goal mode.
+    state : int
+        The state believed.
+    obstacles : numpy.ndarray
+        ``(num_headings,)`` bool collision flag per heading.
+    mode : str
+        ``"explore"`` or ``"goal"``.
+
+    Returns
+    -------
+    action : int
+        The control.
+    summary : dict
+        Root ``actions``, ``Q``, ``visits``, the ``objective``, the planning ``arrays``, the
+        ``obstacles`` flags (stay appended) and, while a view-weighted target is pursued, the
+        ``preferred`` states.
+    """
     n = model.num_states[0]
     obstacles = np.asarray(obstacles, dtype=bool)
-    mcfg = cfg.mcts
     view = None
     if mode == "goal":  # preferences C (set by the agent's goal) weighted 10, inductive term, collision
         objective = efe.goal(goal_weight=cfg.goal_weight, inductive_weight=cfg.inductive_weight)
-        goal_states = agent.goal_states()
+        goal_states = goals
     else:
         objective, goal_states = efe.exploration(), None
-        views, seen_from = agent.memory.views, agent.scanned_from()
-        areas = views.areas(agent.poses, seen_from) if cfg.view_weighting else None
+        areas = views.areas(model.pose.poses[:n], seen_from) if cfg.view_weighting else None
         if areas is not None:  # what the LiDAR has sensed weights the information gain; informative views pull
-            goal_states = _target(agent, state, areas)
+            goal_states = _target(model, cfg, views, seen_from, state, areas)
             if goal_states.size:
                 objective = efe.sensed_exploration(inductive_weight=cfg.explore_inductive_weight)
                 view = views.fractions(areas)
@@ -107,7 +138,7 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     at_goal = mode == "goal" and (bool(np.isin(state, goal_states)) or obstacles.all())
     obstacles = np.append(obstacles, not at_goal)
     arrays = from_model(model, goal_states=goal_states, view=view, collision_pref=cfg.collision_preference)
-    d = mcts_decide(arrays, [agent.q[:n]], obstacles, objective, config=mcfg, rng=agent.rng)
+    d = mcts_decide(arrays, [q[:n]], obstacles, objective, config=cfg.mcts, rng=rng)
     out = {"actions": d.actions, "Q": d.Q, "visits": d.visits, "objective": objective, "arrays": arrays,
            "obstacles": obstacles}
     if view is not None:
@@ -115,13 +146,13 @@ def decide(agent, state: int, obstacles, mode: str) -> tuple[int, dict]:
     return int(d.action), out
 
 
-def term_breakdown(agent, efe_summary: dict, action: int) -> dict[str, float]:
+def term_breakdown(q: np.ndarray, efe_summary: dict, action: int) -> dict[str, float]:
     """Weighted contribution of every EFE term to the first step of ``action`` (same sign as G:
     negative is attractive), as the last decision's objective saw it. Call it right after the
     decision (the model keeps learning)."""
     arrays, objective = efe_summary["arrays"], efe_summary["objective"]
     prep = prepare(arrays, local=True)
-    q = np.asarray(agent.q[: arrays.num_states[0]], dtype=float)
+    q = np.asarray(q[: arrays.num_states[0]], dtype=float)
     idx = np.flatnonzero(q > 1e-9 * q.max())
     coll = np.asarray(efe_summary["obstacles"], dtype=float)[[action]]
     ctx = LocalStep(prep, idx, q[idx] / q[idx].sum(), np.array([action]), 0, coll)

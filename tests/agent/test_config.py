@@ -94,12 +94,13 @@ def test_planner_uses_the_configured_collision_preference(pref):
     state = int(np.argmax(agent.q))
     flags = np.zeros(cfg.num_headings, dtype=bool)
     flags[0] = True  # heading 0 reported blocked
-    action, efe = planner.decide(agent, state, flags, "explore")
+    action, efe = planner.decide(agent.model, agent.cfg, agent.q, agent.rng, agent.memory.views,
+                                 agent.scanned_from(), None, state, flags, "explore")
     assert efe["arrays"].collision_pref == pref
     # the collision term of Eq. 6 for a surely blocked move is P(collision) * ln P~(collision);
     # the breakdown has the sign of G (a penalty is positive)
-    assert planner.term_breakdown(agent, efe, 0)["collision"] == pytest.approx(-pref)
-    assert planner.term_breakdown(agent, efe, 1)["collision"] == 0.0
+    assert planner.term_breakdown(agent.q, efe, 0)["collision"] == pytest.approx(-pref)
+    assert planner.term_breakdown(agent.q, efe, 1)["collision"] == 0.0
 
 
 def test_encoders_follow_the_protocol_and_an_incomplete_one_is_refused():
