@@ -95,6 +95,19 @@ class _Common:
         """Log-preference of a collision (no collision: 0)."""
         return self.prep.arrays.collision_pref
 
+    @cached_property
+    def closer(self):
+        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
+
+        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
+        AIMAPP paper).
+        """
+        dist = self.prep.dist
+        if dist is None:
+            return None
+        q, to_goal, from_anchor = self._goal_distances(dist)
+        return ind.closer_probability(q, to_goal, from_anchor, self.prep.arrays.inductive_depth)
+
 
 class DenseStep(_Common):
     """One planning step from batched beliefs ``qs_prev`` under ``actions``, on full (multi-factor) beliefs.
@@ -208,19 +221,9 @@ class DenseStep(_Common):
         f = self._a.pose_factor
         return self.qs[f] @ v[: self._a.num_states[f]]
 
-    @cached_property
-    def closer(self):
-        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
-
-        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
-        AIMAPP paper).
-        """
-        dist = self.prep.dist
-        if dist is None:
-            return None
+    def _goal_distances(self, dist):
         f = self._a.goal_factor
-        anchor = self.qs_prev[f].argmax(axis=1)
-        return ind.closer_probability(self.qs[f], dist, dist[anchor], self._a.inductive_depth)
+        return self.qs[f], dist, dist[self.qs_prev[f].argmax(axis=1)]
 
 
 class LocalStep(_Common):
@@ -394,21 +397,9 @@ class LocalStep(_Common):
         v = self._a.view
         return None if v is None else self.qs[0] @ v[self.U]
 
-    @cached_property
-    def closer(self):
-        """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
-
-        Staying on a goal state counts too; only goals within the inductive horizon count (Eq. 9 of the
-        AIMAPP paper).
-        """
-        dist = self.prep.dist
-        if dist is None:
-            return None
+    def _goal_distances(self, dist):
         anchor = self.prior_idx[self.prior_p.argmax()]
-        K = self.num_candidates
-        return ind.closer_probability(
-            self.qs[0], dist[self.U], np.full(K, dist[anchor]), self._a.inductive_depth
-        )
+        return self.qs[0], dist[self.U], np.full(self.num_candidates, dist[anchor])
 
     def most_likely(self) -> np.ndarray:
         """Most likely next state per candidate (summing repeated states of a point prior).
