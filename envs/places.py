@@ -33,34 +33,41 @@ def _free_sampler(sim, rng: np.random.Generator, clearance: float):
     return ok, draw
 
 
-def displaced_pairs(sim, dx: float, n: int, rng: np.random.Generator,
-                    clearance: float = CLEARANCE, max_tries: int = 100_000):
-    """n pairs (a, b) with |b - a| = dx in a random direction, the segment clear."""
+def _pairs(sim, n: int, rng: np.random.Generator, clearance: float, max_tries: int, propose) -> list:
+    """Up to ``n`` pairs ``propose(draw, ok)`` returns (None: rejected), in at most ``max_tries`` draws."""
     ok, draw = _free_sampler(sim, rng, clearance)
     out = []
     for _ in range(max_tries):
         if len(out) == n:
             break
+        pair = propose(draw, ok)
+        if pair is not None:
+            out.append(pair)
+    return out
+
+
+def displaced_pairs(sim, dx: float, n: int, rng: np.random.Generator,
+                    clearance: float = CLEARANCE, max_tries: int = 100_000):
+    """n pairs (a, b) with |b - a| = dx in a random direction, the segment clear."""
+
+    def propose(draw, ok):
         a = draw()
         th = rng.uniform(0, 2 * np.pi)
         b = a + dx * np.array([np.cos(th), np.sin(th)])
-        if ok(a + np.linspace(0, 1, 12)[:, None] * (b - a)):
-            out.append((a, b))
-    return out
+        return (a, b) if ok(a + np.linspace(0, 1, 12)[:, None] * (b - a)) else None
+
+    return _pairs(sim, n, rng, clearance, max_tries, propose)
 
 
 def distant_pairs(sim, d_min: float, n: int, rng: np.random.Generator,
                   clearance: float = CLEARANCE, max_tries: int = 100_000):
     """n pairs of free reachable places at least d_min apart."""
-    ok, draw = _free_sampler(sim, rng, clearance)
-    out = []
-    for _ in range(max_tries):
-        if len(out) == n:
-            break
+
+    def propose(draw, ok):
         a, b = draw(), draw()
-        if np.hypot(*(a - b)) >= d_min and ok(np.stack([a, b])):
-            out.append((a, b))
-    return out
+        return (a, b) if np.hypot(*(a - b)) >= d_min and ok(np.stack([a, b])) else None
+
+    return _pairs(sim, n, rng, clearance, max_tries, propose)
 
 
 def panorama_at(sim, xy) -> np.ndarray:

@@ -20,6 +20,15 @@ COLORS = {"aimapp": "C0", "aimapp_revisits": "C5", "frontier": "C1", "frontier_p
 CAUSES = ("stuck", "collision", "map")
 
 
+def _cells(plan: dict, groups: dict):
+    """``(env, method, results)`` for every env and method of ``plan`` that has results, in plan order."""
+    for env in plan["envs"]:
+        for method in plan["methods"]:
+            rs = [r["result"] for r in groups.get((env, method), [])]
+            if rs:
+                yield env, method, rs
+
+
 def _pm(s: dict, digits: int = 2) -> str:
     if s.get("mean") is None:
         return "–"
@@ -133,23 +142,19 @@ def exploration_report(study_dir: Path, plan, results) -> str:
               "CE end (successful)", "nAUC end (successful)", "coverage end", "distance end (m)",
               "paper CE", "paper nAUC"]
     rows = []
-    for env in plan["envs"]:
-        for method in plan["methods"]:
-            rs = [r["result"] for r in groups.get((env, method), [])]
-            if not rs:
-                continue
-            ok = [r for r in rs if r["success"]]
-            reached = sum(r.get("at_level") is not None for r in rs)
-            pname = paper.PAPER_NAME.get(method)
-            pv = paper.EXPLORATION.get(env, {}).get(pname, {}) if pname else {}
-            rows.append([
-                env, METHOD_LABEL[method], counts.get((env, method, None), len(rs)), f"{len(ok)}/{len(rs)}",
-                f"{reached}/{len(rs)}",
-                _pm(summarise([_ep(r, "lvl", "ce") for r in ok])), _pm(summarise([_ep(r, "lvl", "ce") for r in rs])),
-                _pm(summarise([_ep(r, "lvl", "nauc") for r in ok])),
-                _pm(summarise([r["ce"] for r in ok])), _pm(summarise([r["nauc"] for r in ok])),
-                _pm(summarise([r["coverage"] for r in rs])), _pm(summarise([r["distance_m"] for r in rs]), 1),
-                _paper_pm(pv.get("ce")), _paper_pm(pv.get("nauc"))])
+    for env, method, rs in _cells(plan, groups):
+        ok = [r for r in rs if r["success"]]
+        reached = sum(r.get("at_level") is not None for r in rs)
+        pname = paper.PAPER_NAME.get(method)
+        pv = paper.EXPLORATION.get(env, {}).get(pname, {}) if pname else {}
+        rows.append([
+            env, METHOD_LABEL[method], counts.get((env, method, None), len(rs)), f"{len(ok)}/{len(rs)}",
+            f"{reached}/{len(rs)}",
+            _pm(summarise([_ep(r, "lvl", "ce") for r in ok])), _pm(summarise([_ep(r, "lvl", "ce") for r in rs])),
+            _pm(summarise([_ep(r, "lvl", "nauc") for r in ok])),
+            _pm(summarise([r["ce"] for r in ok])), _pm(summarise([r["nauc"] for r in ok])),
+            _pm(summarise([r["coverage"] for r in rs])), _pm(summarise([r["distance_m"] for r in rs]), 1),
+            _paper_pm(pv.get("ce")), _paper_pm(pv.get("nauc"))])
     csv_rows = []
     for r in sorted(results, key=lambda r: r["key"]):
         s, x = r["spec"], r["result"]
@@ -341,19 +346,15 @@ def success_report(study_dir: Path, plan, results) -> str:
     header = ["Env.", "Method", "distinct runs", "success rate", "interventions stuck / collision / map",
               "failed moves", f"reached {level:.0%}", "paper success", "paper interventions"]
     rows = []
-    for env in plan["envs"]:
-        for method in plan["methods"]:
-            rs = [r["result"] for r in groups.get((env, method), [])]
-            if not rs:
-                continue
-            pname = paper.PAPER_NAME.get(method)
-            ps = paper.SUCCESS.get(env, {}).get(pname) if pname else None
-            pi = paper.INTERVENTIONS.get(env, {}).get(pname) if pname else None
-            rows.append([env, METHOD_LABEL[method], counts.get((env, method, None), len(rs)),
-                         f"{np.mean([r['success'] for r in rs]):.2f} ({sum(r['success'] for r in rs)}/{len(rs)})",
-                         _causes(rs), sum(r["failed_moves"] for r in rs),
-                         f"{sum(r.get('at_level') is not None for r in rs)}/{len(rs)}",
-                         "–" if ps is None else f"{ps:.2f}", "–" if pi is None else pi])
+    for env, method, rs in _cells(plan, groups):
+        pname = paper.PAPER_NAME.get(method)
+        ps = paper.SUCCESS.get(env, {}).get(pname) if pname else None
+        pi = paper.INTERVENTIONS.get(env, {}).get(pname) if pname else None
+        rows.append([env, METHOD_LABEL[method], counts.get((env, method, None), len(rs)),
+                     f"{np.mean([r['success'] for r in rs]):.2f} ({sum(r['success'] for r in rs)}/{len(rs)})",
+                     _causes(rs), sum(r["failed_moves"] for r in rs),
+                     f"{sum(r.get('at_level') is not None for r in rs)}/{len(rs)}",
+                     "–" if ps is None else f"{ps:.2f}", "–" if pi is None else pi])
     write_csv(study_dir / "table.csv", header, rows)
     endpoint = ("the whole run (interventions are looked for over every decision); 'reached' counts runs whose "
                 f"coverage reached {level:.0%} at some point.")
