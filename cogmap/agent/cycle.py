@@ -77,14 +77,9 @@ def update(model: Model, cfg: AgentConfig, belief: Belief, counts: Counts, memor
         The posterior of :func:`infer`.
     conf : Confidence
         Its confidence test.
-    obs : int or None
-        Observation id (None: camera silent).
-    sensed : Sensed
-        The reading in the belief frame.
-    pose : numpy.ndarray
-        ``(2,)`` believed position, metres.
-    score : float
-        The encoder's best similarity score.
+    obs, sensed, pose, score
+        The view's observation id, the reading in the belief frame, the believed position and the
+        encoder's score, as :func:`learn` takes them.
 
     Returns
     -------
