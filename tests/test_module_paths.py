@@ -158,3 +158,37 @@ def test_inference_planning_and_envs_import_only_genmodel_of_each_other():
     bad = sorted(f"{m} -> {t}" for m, targets in graph.items() for t in targets for lib in libs
                  if m.startswith(lib) and any(t.startswith(o) for o in libs if o != lib))
     assert bad == []
+
+
+def _self_attributes(cls: ast.ClassDef) -> set[str]:
+    """Names ``X`` of every ``self.X = ...`` (also augmented or annotated) in the class body."""
+    out = set()
+    for node in ast.walk(cls):
+        targets = node.targets if isinstance(node, ast.Assign) else [node.target] if isinstance(
+            node, ast.AnnAssign | ast.AugAssign) else []
+        for t in targets:
+            for e in ast.walk(t):
+                if isinstance(e, ast.Attribute) and isinstance(e.value, ast.Name) and e.value.id == "self":
+                    out.add(e.attr)
+    return out
+
+
+def test_agent_layer_classes_stay_small():
+    """No class of the agent layer (``cogmap/`` outside the four libraries) spans more than 300 lines
+    or sets more than 10 attributes on ``self``: its state belongs in records, its maths in functions."""
+    libs = {"genmodel", "inference", "planning", "envs"}
+    big = []
+    for path in (ROOT / "cogmap").rglob("*.py"):
+        if path.relative_to(ROOT / "cogmap").parts[0] in libs:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.ClassDef):
+                lines, attrs = node.end_lineno - node.lineno + 1, len(_self_attributes(node))
+                if lines > 300 or attrs > 10:
+                    big.append(f"{path.relative_to(ROOT)}:{node.name} ({lines} lines, {attrs} attributes)")
+    assert big == []
+
+
+def test_the_class_size_check_sees_lines_and_attributes():
+    tree = ast.parse("class A:\n    def __init__(self):\n" + "".join(f"        self.a{i} = {i}\n" for i in range(11)))
+    assert len(_self_attributes(tree.body[0])) == 11
