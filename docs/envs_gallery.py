@@ -6,7 +6,6 @@ its observation and action spaces (as the environment declares them) and a rende
 
 from __future__ import annotations
 
-import importlib
 import inspect
 from pathlib import Path
 
@@ -39,10 +38,15 @@ def space_rows(space: gym.Space) -> list[tuple[str, str]]:
     return [("", str(space))]
 
 
-def entry_doc(spec) -> str:
-    """The docstring of the module that defines the environment class (what the spaces mean)."""
-    module = importlib.import_module(spec.entry_point.split(":")[0])
-    return inspect.cleandoc(module.__doc__ or "")
+def entry_doc(env) -> str:
+    """The docstring of the module that defines the environment's class (what the spaces mean)."""
+    return inspect.cleandoc(inspect.getmodule(type(env.unwrapped)).__doc__ or "")
+
+
+def entry_name(env) -> str:
+    """``module:Class`` of the environment ``gymnasium.make`` built."""
+    cls = type(env.unwrapped)
+    return f"{cls.__module__}:{cls.__qualname__}"
 
 
 def describe(env_id: str) -> dict:
@@ -50,10 +54,10 @@ def describe(env_id: str) -> dict:
     spec = gym.spec(env_id)
     env = gym.make(env_id)
     try:
-        return {"id": env_id, "entry_point": spec.entry_point, "kwargs": dict(spec.kwargs),
+        return {"id": env_id, "entry_point": entry_name(env), "kwargs": dict(spec.kwargs),
                 "max_episode_steps": spec.max_episode_steps,
                 "observation": space_rows(env.observation_space), "action": space_rows(env.action_space),
-                "doc": entry_doc(spec)}
+                "doc": entry_doc(env)}
     finally:
         env.close()
 

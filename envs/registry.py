@@ -39,20 +39,91 @@ DRONE_MAX_STEPS = 250
 BUILTIN_IDS = (*LAYOUT_IDS, GRID_ID, MAZE_ID, DRONE_ID)
 
 
+# The environments' constructors, given to Gymnasium as callables: nothing is imported by a name
+# string (the modules are imported here, when an environment is first made, since pybullet is slow
+# to load).
+def nav_env(**kwargs):
+    """A room (:class:`cogmap.envs.gym_env.NavEnv`), as ``gymnasium.make`` builds it.
+
+    Parameters
+    ----------
+    **kwargs
+        ``NavEnv``'s arguments.
+
+    Returns
+    -------
+    NavEnv
+    """
+    from .gym_env import NavEnv
+
+    return NavEnv(**kwargs)
+
+
+def grid_world_env(**kwargs):
+    """The grid world (:class:`cogmap.envs.gridworld.GridWorldEnv`), as ``gymnasium.make`` builds it.
+
+    Parameters
+    ----------
+    **kwargs
+        ``GridWorldEnv``'s arguments.
+
+    Returns
+    -------
+    GridWorldEnv
+    """
+    from .gridworld import GridWorldEnv
+
+    return GridWorldEnv(**kwargs)
+
+
+def drone_field_env(**kwargs):
+    """The drone field (:class:`cogmap.envs.drone_gym.DroneFieldEnv`), as ``gymnasium.make`` builds it.
+
+    Parameters
+    ----------
+    **kwargs
+        ``DroneFieldEnv``'s arguments.
+
+    Returns
+    -------
+    DroneFieldEnv
+    """
+    from .drone_gym import DroneFieldEnv
+
+    return DroneFieldEnv(**kwargs)
+
+
+def lidar_maze_env(**kwargs):
+    """The LiDAR maze (:class:`cogmap.envs.maze_env.LidarMazeEnv`), as ``gymnasium.make`` builds it.
+
+    Parameters
+    ----------
+    **kwargs
+        ``LidarMazeEnv``'s arguments.
+
+    Returns
+    -------
+    LidarMazeEnv
+    """
+    from .maze_env import LidarMazeEnv
+
+    return LidarMazeEnv(**kwargs)
+
+
 def register_all() -> None:
     """Register all ids (idempotent)."""
     for env_id, layout in LAYOUT_IDS.items():
         if env_id not in gym.registry:
-            gym.register(env_id, entry_point="cogmap.envs.gym_env:NavEnv",
+            gym.register(env_id, entry_point=nav_env,
                          kwargs={"layout": layout}, max_episode_steps=MAX_STEPS)
     if GRID_ID not in gym.registry:
-        gym.register(GRID_ID, entry_point="cogmap.envs.gridworld:GridWorldEnv",
+        gym.register(GRID_ID, entry_point=grid_world_env,
                      max_episode_steps=MAX_STEPS)
     if DRONE_ID not in gym.registry:
-        gym.register(DRONE_ID, entry_point="cogmap.envs.drone_gym:DroneFieldEnv",
+        gym.register(DRONE_ID, entry_point=drone_field_env,
                      max_episode_steps=DRONE_MAX_STEPS)
     if MAZE_ID not in gym.registry:
-        gym.register(MAZE_ID, entry_point="cogmap.envs.maze_env:LidarMazeEnv",
+        gym.register(MAZE_ID, entry_point=lidar_maze_env,
                      max_episode_steps=MAZE_MAX_STEPS)
 
 
@@ -107,7 +178,7 @@ def register_layout(name: str, factory: Callable[..., Layout], *, env_id: str | 
     if env_id is not None:
         LAYOUT_IDS[env_id] = name
         gym.registry.pop(env_id, None)  # overwrite: replace our own earlier registration quietly
-        gym.register(env_id, entry_point="cogmap.envs.gym_env:NavEnv", kwargs={"layout": name},
+        gym.register(env_id, entry_point=nav_env, kwargs={"layout": name},
                      max_episode_steps=max_episode_steps)
 
 
