@@ -11,7 +11,7 @@ name          state / observation                                    info
 ``aimapp``    the :class:`~cogmap.agent.aimapp.AIMAPPAgent` /         ``aimapp.Decision``
               :class:`~cogmap.agent.aimapp.Sensed` (``model`` None:
               grown from the first reading)
-``drone``     the :class:`~cogmap.drone.agent.DroneAgent` /           ``drone.agent.Decision``
+``drone``     the :class:`~cogmap.drone.agent.DroneAgent` /           ``drone_policies.Decision``
               :class:`DroneObservation`
 ============  =====================================================  ==========================
 

@@ -73,10 +73,8 @@ def scan_models(params, cfg, sim, k_std: float = STD_K) -> dict:
 
     Parameters
     ----------
-    params : DVBFParams
-        The learned q(M) and emission.
-    cfg : DVBFConfig
-        Their model.
+    params, cfg : DVBFParams, DVBFConfig
+        The learned model and its configuration, as :func:`learned_scan_fn` takes them.
     sim : MazeSim
         The true simulator (its ``lidar_batch``).
     k_std : float

@@ -19,10 +19,9 @@ def goal_table(params, cfg, encoder: dict = ENCODER):
 
     Parameters
     ----------
-    params : DVBFParams
-        The learned q(M) and emission.
-    cfg : DVBFConfig
-        Their model.
+    params, cfg : DVBFParams, DVBFConfig
+        The learned model and its configuration (see
+        :func:`cogmap.genmodel.dvbf_scan.learned_scan_fn`).
     encoder : dict
         ``n_xy`` and ``n_heading`` (see :data:`ENCODER`).
 

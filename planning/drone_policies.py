@@ -89,7 +89,8 @@ class _Plan:
 
 
 class StraightLine(DronePolicy):
-    """Fly toward the target in steps of ``step`` metres, blind to obstacles.
+    """Fly toward the target in steps of ``step`` metres (to the target itself when closer), blind to
+    obstacles.
 
     Parameters
     ----------
@@ -113,21 +114,7 @@ class StraightLine(DronePolicy):
         """
         return {"policy": "straight", "step": self.step, "speeds": list(self.speeds)}
 
-    def decide(self, position, target) -> Decision:
-        """A waypoint ``step`` metres toward the target (the target itself when closer).
-
-        Parameters
-        ----------
-        position : array_like
-            ``(3,)`` current position, metres, world frame.
-        target : array_like
-            ``(3,)`` target position, metres.
-
-        Returns
-        -------
-        Decision
-            ``waypoint`` (``(3,)`` metres), ``speed`` (m/s), ``plan``, ``plan_ms`` and ``state``.
-        """
+    def decide(self, position, target) -> Decision:  # documented in DronePolicy.decide
         pos, tgt = np.asarray(position, float), np.asarray(target, float)
         d = tgt - pos
         n = float(np.linalg.norm(d))
@@ -136,7 +123,8 @@ class StraightLine(DronePolicy):
 
 
 class PotentialField(DronePolicy):
-    """Attraction to the target plus repulsion from voxels within ``influence`` metres.
+    """Attraction to the target plus repulsion from voxels within ``influence`` metres; each decision
+    is one step along the summed force.
 
     Repulsion ``k_rep (1/d - 1/influence) / d^2`` along the away direction; one step of ``step``
     metres along the resulting force; a floor keeps it above ``min_altitude``.
@@ -188,21 +176,7 @@ class PotentialField(DronePolicy):
         """
         self.voxels = VoxelMap()
 
-    def decide(self, position, target) -> Decision:
-        """One step along the summed attractive and repulsive force.
-
-        Parameters
-        ----------
-        position : array_like
-            ``(3,)`` current position, metres, world frame.
-        target : array_like
-            ``(3,)`` target position, metres.
-
-        Returns
-        -------
-        Decision
-            ``waypoint`` (``(3,)`` metres), ``speed`` (m/s), ``plan``, ``plan_ms`` and ``state``.
-        """
+    def decide(self, position, target) -> Decision:  # documented in DronePolicy.decide
         pos, tgt = np.asarray(position, float), np.asarray(target, float)
         d = tgt - pos
         n = float(np.linalg.norm(d))

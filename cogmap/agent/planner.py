@@ -10,6 +10,8 @@ from cogmap.planning.arrays import from_model, prepare
 from cogmap.planning.context import LocalStep
 from cogmap.planning.decide import decide as mcts_decide
 
+from .map_growth import state_poses
+
 
 def _target(model, cfg, views, seen_from: np.ndarray, state: int, areas: np.ndarray) -> np.ndarray:
     """The preferred state of the inductive term while exploring (docs/exploration.md).
@@ -28,7 +30,7 @@ def _target(model, cfg, views, seen_from: np.ndarray, state: int, areas: np.ndar
     ``views.pursuit.unreached`` counts the viewpoints and the paper's terms alone decide."""
     B, n = model.B[0], model.num_states[0]
     aim = views.pursuit
-    poses, visited = model.pose.poses[:n], np.asarray(seen_from[:n], dtype=bool)
+    poses, visited = state_poses(model), np.asarray(seen_from[:n], dtype=bool)
     xy, gains = views.viewpoints(poses, visited, areas)
     src, dst = B.edges(cfg.inductive_threshold, n)
     doubt = views.doubtful(poses, src, dst, state)
@@ -123,7 +125,7 @@ def decide(model, cfg, q: np.ndarray, rng: np.random.Generator, views, seen_from
         goal_states = goals
     else:
         objective, goal_states = efe.exploration(), None
-        areas = views.areas(model.pose.poses[:n], seen_from) if cfg.view_weighting else None
+        areas = views.areas(state_poses(model), seen_from) if cfg.view_weighting else None
         if areas is not None:  # what the LiDAR has sensed weights the information gain; informative views pull
             goal_states = _target(model, cfg, views, seen_from, state, areas)
             if goal_states.size:

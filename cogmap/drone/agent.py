@@ -95,7 +95,9 @@ class DroneAgent(DronePolicy):
     """The drone's stateful shell: voxel memory, kernel beliefs, RNG; the maths lives in the libraries.
 
     ``observe(scan)`` feeds LiDAR sweeps (also those taken in flight); ``decide(position, target)``
-    returns a :class:`Decision`.
+    senses, updates the kernel beliefs, plans and ranks candidate waypoints through the planner
+    ``"drone"`` and returns the first action as a :class:`Decision`, slowing down near the target or
+    in dense clutter.
 
     Parameters
     ----------
@@ -183,23 +185,7 @@ class DroneAgent(DronePolicy):
         rho = density(position, V)
         return V, d_obs, rho, float(suitability(d_obs, rho))
 
-    def decide(self, position, target) -> Decision:
-        """Sense, update the kernel beliefs, plan and rank candidate waypoints; return the first action.
-
-        Slows down near the target or in dense clutter.
-
-        Parameters
-        ----------
-        position : array_like
-            ``(3,)`` current position, metres, world frame.
-        target : array_like
-            ``(3,)`` target position, metres.
-
-        Returns
-        -------
-        Decision
-            ``waypoint`` (``(3,)`` metres), ``speed`` (m/s), ``plan``, ``plan_ms`` and ``state``.
-        """
+    def decide(self, position, target) -> Decision:  # documented in DronePolicy.decide
         pos = np.asarray(position, float)
         tgt = np.asarray(target, float)
         if self.d_start is None:
