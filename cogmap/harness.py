@@ -16,13 +16,13 @@ metrics), acting on the simulator and the stopping rules. A policy follows :clas
 
 from __future__ import annotations
 
-import time
 import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from cogmap.genmodel.contracts import Episode as EpisodeContract
 from cogmap.genmodel.contracts import EpisodePolicy as Policy
 from cogmap.metrics import CoverageTracker
 
@@ -146,6 +146,76 @@ def execute(sim, command: Command) -> bool:
     return bool(sim.move_to(command.waypoint, frame=command.frame).success)
 
 
+class RoomEpisode(EpisodeContract):
+    """A room run as :func:`cogmap.envs.episode.run` drives it: LiDAR coverage, trajectory rows and
+    the stopping rules of :func:`run_episode`.
+
+    Parameters
+    ----------
+    sim : NavSim
+        The simulator.
+    ep : Episode
+        The record to extend.
+    dist : float
+        Distance driven so far, metres.
+    on_step, stop, stop_coverage, after_step
+        As in :func:`run_episode`.
+    """
+
+    def __init__(self, sim, ep: Episode, dist: float, on_step=None, stop=None, stop_coverage=None, after_step=None):
+        self.sensors, self.ep, self.dist = sim, ep, dist
+        self.tracker = coverage_tracker(sim)
+        self.on_step, self.stop_rule, self.stop_coverage, self.after_step = on_step, stop, stop_coverage, after_step
+        self.moved, self.last_status = None, {}
+
+    def stop(self) -> str | None:
+        sweep(self.sensors, self.tracker)
+        if self.stop_coverage is not None and self.tracker.coverage >= self.stop_coverage:
+            return "coverage"
+        return None
+
+    def decided(self, cmd: Command, ms: float) -> str | None:
+        sim, ep, cov = self.sensors, self.ep, self.tracker.coverage
+        true, odom = sim.true_pose(), sim.odometry()
+        odom = np.full(3, np.nan) if odom is None else odom
+        ep.coverage.append(cov)
+        ep.distance.append(self.dist)
+        ep.decision_ms.append(ms)
+        ep.num_states.append(int(cmd.row.get("num_states", 0)))
+        ep.rows.append(dict(
+            step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
+            odom_yaw=odom[2], **cmd.row, moved=self.moved, coverage=cov, distance=self.dist, decision_ms=ms,
+        ))
+        self.last_status = dict(cov=f"{cov:.0%}", **cmd.status)
+        if cmd.done:
+            return "done"
+        if self.on_step is not None:
+            self.on_step(cmd.decision)
+        return None
+
+    def act(self, cmd: Command) -> bool:
+        sim = self.sensors
+        before = sim.true_pose()[:2]
+        self.moved = execute(sim, cmd)
+        self.dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
+        return self.moved
+
+    def acted(self, cmd: Command, moved: bool) -> str | None:
+        if self.stop_rule is not None and self.stop_rule(cmd.decision):
+            return "stop"
+        if self.after_step is not None:
+            self.after_step(self.ep, moved, self.dist)
+        return None
+
+    def status(self) -> dict:
+        return self.last_status
+
+    def end(self) -> None:
+        sweep(self.sensors, self.tracker)
+        self.ep.coverage.append(self.tracker.coverage)
+        self.ep.distance.append(self.dist)
+
+
 def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, episode: Episode | None = None,
                 on_step=None, stop=None, stop_coverage: float | None = None, desc: str | None = None,
                 after_step=None, moved: bool | None = None, distance: float | None = None) -> Episode:
@@ -187,43 +257,11 @@ def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, epis
     Episode
         The (new or continued) episode record.
     """
-    from tqdm import tqdm
+    from cogmap.envs.episode import run
 
     ep = episode if episode is not None else Episode()
-    tracker = coverage_tracker(sim)
     dist = distance if distance is not None else (ep.distance[-1] if ep.distance else 0.0)
-    bar = tqdm(range(steps), disable=not progress, desc=desc or policy.label, unit="step", leave=True)
-    for _ in bar:
-        sweep(sim, tracker)
-        if stop_coverage is not None and tracker.coverage >= stop_coverage:
-            break
-        sensed = policy.sense(sim, moved)
-        t0 = time.perf_counter()
-        cmd = policy.step(sensed)
-        ms = 1e3 * (time.perf_counter() - t0)
-        true, odom = sim.true_pose(), sim.odometry()
-        odom = np.full(3, np.nan) if odom is None else odom
-        ep.coverage.append(tracker.coverage)
-        ep.distance.append(dist)
-        ep.decision_ms.append(ms)
-        ep.num_states.append(int(cmd.row.get("num_states", 0)))
-        ep.rows.append(dict(
-            step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
-            odom_yaw=odom[2], **cmd.row, moved=moved, coverage=tracker.coverage, distance=dist, decision_ms=ms,
-        ))
-        bar.set_postfix(cov=f"{tracker.coverage:.0%}", **cmd.status)
-        if cmd.done:
-            break
-        if on_step is not None:
-            on_step(cmd.decision)
-        before = sim.true_pose()[:2]
-        moved = execute(sim, cmd)
-        dist += float(np.hypot(*(sim.true_pose()[:2] - before)))
-        if stop is not None and stop(cmd.decision):
-            break
-        if after_step is not None:
-            after_step(ep, moved, dist)
-    sweep(sim, tracker)
-    ep.coverage.append(tracker.coverage)
-    ep.distance.append(dist)
+    room = RoomEpisode(sim, ep, dist, on_step=on_step, stop=stop, stop_coverage=stop_coverage, after_step=after_step)
+    room.moved = moved
+    run(room, policy, steps, outcome=moved, progress=progress, desc=desc)
     return ep

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from cogmap.genmodel.contracts import Episode, EpisodePolicy
 from cogmap.genmodel.numerics import wrap_angle
 
 from .maze import Maze
@@ -68,9 +69,94 @@ def _waypoints(maze: Maze, path, offset: float) -> list[np.ndarray]:
     return pts
 
 
+class MazeRun(Episode):
+    """A maze run as :func:`cogmap.envs.episode.run` drives it: each control is stepped in the
+    simulator and the true pose, control, scan and bump are recorded (no stopping rule of its own).
+
+    Parameters
+    ----------
+    sim : MazeSim
+        The simulator, already reset.
+    pose : numpy.ndarray
+        ``(3,)`` the start pose.
+    scan : numpy.ndarray
+        ``(n_beams,)`` the scan at the start.
+    """
+
+    def __init__(self, sim: MazeSim, pose, scan):
+        self.sensors = sim
+        self.poses, self.controls, self.scans, self.blocked = [pose], [], [scan], []
+
+    def act(self, u):  # the outcome is (pose, scan, blocked)
+        pose, hit = self.sensors.step(u)
+        scan = self.sensors.lidar()
+        self.poses.append(pose)
+        self.controls.append(np.asarray(u, float))
+        self.scans.append(scan)
+        self.blocked.append(hit)
+        return pose, scan, hit
+
+    def traversal(self) -> Traversal:
+        """The run so far as arrays."""
+        return Traversal(np.array(self.poses), np.array(self.controls), np.array(self.scans),
+                         np.array(self.blocked, bool))
+
+
+class Operator(EpisodePolicy):
+    """The seeded operator as a policy of :func:`cogmap.envs.episode.run`: walk the waypoints of a
+    cell path to a distant cell, steering at most ``max_turn`` per step; a bump re-plans.
+
+    Parameters
+    ----------
+    maze : Maze
+        The maze.
+    rng : numpy.random.Generator
+        Draws the goals, the wall offsets and the steering noise.
+    step : float
+        Forward step per time step, maze units.
+    max_turn : float
+        Largest turn per time step, radians.
+    """
+
+    label = "operator"
+
+    def __init__(self, maze: Maze, rng: np.random.Generator, step: float, max_turn: float):
+        self.maze, self.rng, self.step_length, self.max_turn = maze, rng, step, max_turn
+        self.waypoints: list[np.ndarray] = []
+
+    def sense(self, sim, outcome):
+        return outcome
+
+    def step(self, sensed) -> np.ndarray:  # the next (turn, forward) from the last (pose, scan, blocked)
+        maze, rng, step = self.maze, self.rng, self.step_length
+        pose, _, hit = sensed
+        if hit:  # replan from where the wall stopped us
+            self.waypoints = []
+        while True:
+            if not self.waypoints:
+                here = maze.cell_of(pose[:2])
+                cells = [(i, j) for i in range(maze.n) for j in range(maze.n) if (i, j) != here]
+                far = np.array([abs(i - here[0]) + abs(j - here[1]) for i, j in cells], float)
+                goal = cells[int(rng.choice(len(cells), p=far / far.sum()))]
+                kind = rng.random()
+                offset = 0.0 if kind < 0.4 else float(rng.choice([-1, 1]) * rng.uniform(0.2, 0.32))
+                self.waypoints = _waypoints(maze, cell_path(maze, here, goal), offset)[1:]
+            d = self.waypoints[0] - pose[:2]
+            dist = float(np.hypot(*d))
+            if dist < 0.6 * step:
+                self.waypoints.pop(0)
+                continue
+            err = float(wrap_angle(np.arctan2(d[1], d[0]) - pose[2]))
+            turn = float(np.clip(err + 0.05 * rng.standard_normal(), -self.max_turn, self.max_turn))
+            fwd = min(step, dist) if abs(err - turn) < 0.5 else 0.25 * step
+            return np.array([turn, fwd])
+
+
 def traverse(maze: Maze, steps: int, seed: int = 0, step: float = 0.01, max_turn: float = 0.35,
              noise: ActuationNoise | None = None, start=None, sim: MazeSim | None = None) -> Traversal:
     """Record ``steps`` poses of a seeded operator walking through ``maze``."""
+    from .episode import run
+
     if steps < 1:
         raise ValueError(f"traverse: steps must be >= 1, got {steps}")
     rng = np.random.default_rng(seed)
@@ -81,35 +167,10 @@ def traverse(maze: Maze, steps: int, seed: int = 0, step: float = 0.01, max_turn
             c0 = (int(rng.integers(maze.n)), int(rng.integers(maze.n)))
             start = (*maze.cell_centre(*c0), float(rng.uniform(-np.pi, np.pi)))
         pose = sim.reset(start)
-        poses, controls, scans, blocked = [pose], [], [sim.lidar()], []
-        waypoints: list[np.ndarray] = []
-        while len(poses) < steps:
-            if not waypoints:
-                here = maze.cell_of(pose[:2])
-                cells = [(i, j) for i in range(maze.n) for j in range(maze.n) if (i, j) != here]
-                far = np.array([abs(i - here[0]) + abs(j - here[1]) for i, j in cells], float)
-                goal = cells[int(rng.choice(len(cells), p=far / far.sum()))]
-                kind = rng.random()
-                offset = 0.0 if kind < 0.4 else float(rng.choice([-1, 1]) * rng.uniform(0.2, 0.32))
-                waypoints = _waypoints(maze, cell_path(maze, here, goal), offset)[1:]
-            target = waypoints[0]
-            d = target - pose[:2]
-            dist = float(np.hypot(*d))
-            if dist < 0.6 * step:
-                waypoints.pop(0)
-                continue
-            err = float(wrap_angle(np.arctan2(d[1], d[0]) - pose[2]))
-            turn = float(np.clip(err + 0.05 * rng.standard_normal(), -max_turn, max_turn))
-            fwd = min(step, dist) if abs(err - turn) < 0.5 else 0.25 * step
-            u = np.array([turn, fwd])
-            pose, hit = sim.step(u)
-            controls.append(u)
-            blocked.append(hit)
-            poses.append(pose)
-            scans.append(sim.lidar())
-            if hit:  # replan from where the wall stopped us
-                waypoints = []
-        return Traversal(np.array(poses), np.array(controls), np.array(scans), np.array(blocked, bool))
+        scan = sim.lidar()
+        record = MazeRun(sim, pose, scan)
+        run(record, Operator(maze, rng, step, max_turn), steps - 1, outcome=(pose, scan, False))
+        return record.traversal()
     finally:
         if own:
             sim.close()

@@ -182,7 +182,7 @@ class Study(Protocol):
 
 @runtime_checkable
 class EpisodePolicy(Protocol):
-    """What the room episode runner (``cogmap.harness.run_episode``) needs of a policy (runtime-checkable).
+    """What the episode runner (``cogmap.envs.episode.run``) needs of a policy (runtime-checkable).
 
     Attributes
     ----------
@@ -197,10 +197,11 @@ class EpisodePolicy(Protocol):
 
         Parameters
         ----------
-        sim : NavSim
-            The simulator.
-        moved : bool or None
-            Whether the last motion command succeeded; None before the first.
+        sim : object
+            The simulator (``Episode.sensors``).
+        moved : object
+            The outcome of the last action (in a room: whether the motion succeeded), None
+            before the first.
 
         Returns
         -------
@@ -218,9 +219,96 @@ class EpisodePolicy(Protocol):
 
         Returns
         -------
-        Command
-            A ``cogmap.harness.Command``.
+        object
+            The action the episode carries out (in a room a ``cogmap.harness.Command``).
         """
+
+
+class Episode(Protocol):
+    """One run of a policy in a simulator, as the runner (``cogmap.envs.episode.run``) drives it.
+
+    Subclass it to inherit the defaults (no stopping rule, nothing recorded) and these docstrings;
+    ``act`` is each episode's own.
+
+    Attributes
+    ----------
+    sensors : object
+        What the policy reads its sensors from (the simulator).
+    """
+
+    sensors: Any
+
+    def stop(self) -> str | None:
+        """Why the episode ends before the next decision.
+
+        Returns
+        -------
+        str or None
+            The reason, or None to go on (the default).
+        """
+        return None
+
+    def decided(self, action, ms: float) -> str | None:
+        """Record a decision before it is carried out.
+
+        Parameters
+        ----------
+        action : object
+            What the policy decided.
+        ms : float
+            Wall-clock time of the decision, milliseconds.
+
+        Returns
+        -------
+        str or None
+            A reason to end the episode without carrying it out, or None (the default).
+        """
+        return None
+
+    def act(self, action) -> Any:
+        """Carry out an action.
+
+        Parameters
+        ----------
+        action : object
+            What the policy decided.
+
+        Returns
+        -------
+        object
+            Its outcome, which the policy's next ``sense`` receives.
+        """
+        raise NotImplementedError
+
+    def acted(self, action, outcome) -> str | None:
+        """Record what an action did.
+
+        Parameters
+        ----------
+        action : object
+            The action carried out.
+        outcome : object
+            What :meth:`act` returned.
+
+        Returns
+        -------
+        str or None
+            A reason to end the episode, or None (the default).
+        """
+        return None
+
+    def status(self) -> dict:
+        """Fields for the progress bar.
+
+        Returns
+        -------
+        dict
+            Name -> printable value (none by default).
+        """
+        return {}
+
+    def end(self) -> None:
+        """Close the record after the last step (nothing by default)."""
 
 
 def _members(protocol) -> dict[str, object]:

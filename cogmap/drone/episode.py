@@ -9,9 +9,11 @@ about 1.6 s of flight).
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
+
+from cogmap.genmodel.contracts import Episode, EpisodePolicy
 
 SUCCESS_RADIUS = 1.5
 
@@ -109,6 +111,141 @@ def _stuck(times, positions, now: float, window: float, dist: float) -> bool:
     return bool((np.linalg.norm(np.asarray(positions[i:]) - ref, axis=1) < dist).all())
 
 
+@dataclass
+class DroneTrace:
+    """What a drone episode writes down as it goes.
+
+    Attributes
+    ----------
+    times, positions : list
+        Simulated time (s) and position after each step, the start included (the stuck test).
+    plan_ms, efe_us, rules : list
+        Planning time (ms), EFE time per candidate (us) and the rule of each decision.
+    replans : int
+        In-flight replans.
+    steps : int
+        Steps flown.
+    """
+
+    times: list
+    positions: list
+    plan_ms: list = field(default_factory=list)
+    efe_us: list = field(default_factory=list)
+    rules: list = field(default_factory=list)
+    replans: int = 0
+    steps: int = 0
+
+
+class DronePilot(EpisodePolicy):
+    """A drone policy as :func:`cogmap.envs.episode.run` calls it: sense the LiDAR where the drone
+    is, decide toward the target.
+
+    Parameters
+    ----------
+    policy : DronePolicy
+        The drone policy.
+    target : numpy.ndarray
+        ``(3,)`` target position, metres.
+    """
+
+    label = "drone"
+
+    def __init__(self, policy, target):
+        self.policy, self.target = policy, target
+
+    def sense(self, sim, flight):
+        pos = sim.position.copy()
+        self.policy.observe(sim.scan(), pos)
+        return pos
+
+    def step(self, position):
+        return self.policy.decide(position, self.target)
+
+
+class DroneEpisode(Episode):
+    """One drone flight as :func:`cogmap.envs.episode.run` drives it: the stopping rules of
+    :class:`EpisodeLimits`, the flight of each first action (scans in flight go to the policy) and
+    its trace.
+
+    Parameters
+    ----------
+    sim : DroneSim
+        The simulator (reset here).
+    policy : DronePolicy
+        The policy (reset here; in-flight scans and contacts go to it).
+    target : numpy.ndarray
+        ``(3,)`` target position, metres.
+    limits : EpisodeLimits
+        The stopping rules.
+    log : callable, optional
+        ``log(row)`` receives one dict per step.
+    """
+
+    def __init__(self, sim, policy, target, limits: EpisodeLimits, log=None):
+        self.sensors, self.policy, self.target, self.limits, self.log = sim, policy, target, limits, log
+        start = sim.reset()
+        policy.reset(target, start)
+        self.d0 = float(np.linalg.norm(target - start))
+        self.trace = DroneTrace([0.0], [start.copy()])
+
+    def stop(self) -> str | None:
+        sim, lim, tr = self.sensors, self.limits, self.trace
+        if float(np.linalg.norm(self.target - sim.position)) <= lim.success_radius:
+            return "success"
+        if sim.crashed:
+            return "crashed"
+        if tr.steps >= lim.max_steps or sim.time >= lim.max_time_s:
+            return "timeout"
+        if _stuck(tr.times, tr.positions, sim.time, lim.stuck_time_s, lim.stuck_distance):
+            return "stuck"
+        return None
+
+    def decided(self, dec, ms: float) -> None:
+        self.trace.plan_ms.append(dec.plan_ms)
+        self.trace.efe_us.append(dec.plan.efe_us_per_candidate)
+        self.trace.rules.append(dec.plan.rule)
+
+    def act(self, dec):
+        sim, policy, tr = self.sensors, self.policy, self.trace
+        pos = sim.position.copy()
+        replan_d = getattr(getattr(policy, "config", None), "replan_distance", None)
+        flight = sim.fly_to(dec.waypoint, dec.speed, replan_distance=replan_d if policy.replans_in_flight else None,
+                            on_scan=policy.observe)
+        if flight.contact is not None:
+            policy.observe_contact(flight.contact)
+        sim.advance(self.limits.step_overhead_s)
+        tr.steps += 1
+        tr.replans += int(flight.replanned)
+        tr.times.append(sim.time)
+        tr.positions.append(sim.position.copy())
+        if self.log is not None:
+            self.log({"step": tr.steps, "time_s": round(sim.time, 3), "x": pos[0], "y": pos[1], "z": pos[2],
+                      "wx": dec.waypoint[0], "wy": dec.waypoint[1], "wz": dec.waypoint[2],
+                      "ex": sim.position[0], "ey": sim.position[1], "ez": sim.position[2],
+                      "distance": float(np.linalg.norm(self.target - sim.position)), "collided": int(flight.collided),
+                      "replanned": int(flight.replanned), "rule": dec.plan.rule, "plan_ms": round(dec.plan_ms, 4)})
+        return flight
+
+    def metrics(self, outcome: str) -> dict:
+        """The episode's metrics (see :func:`fly_episode`)."""
+        sim, tr, tgt = self.sensors, self.trace, self.target
+        final = float(np.linalg.norm(tgt - sim.position))
+        success = outcome == "success"
+        pm = np.asarray(tr.plan_ms) if tr.plan_ms else np.zeros(1)
+        eu = np.asarray([e for e in tr.efe_us if np.isfinite(e)])
+        return {
+            "outcome": outcome, "success": success, "stuck": outcome == "stuck", "timeout": outcome == "timeout",
+            "crashed": outcome == "crashed", "collisions": int(sim.collisions),
+            "collision_free_success": bool(success and sim.collisions == 0), "replans": tr.replans,
+            "steps": tr.steps, "initial_distance": self.d0, "final_distance": final, "time_s": round(sim.time, 3),
+            "fallback_steps": sum(r.startswith("fallback") for r in tr.rules),
+            "plan_ms_median": float(np.median(pm)), "plan_ms_p95": float(np.percentile(pm, 95)),
+            "efe_us_per_candidate_median": float(np.median(eu)) if len(eu) else None,
+            "plan_ms": [round(float(x), 4) for x in tr.plan_ms],
+            "target": [float(v) for v in tgt], "limits": asdict(self.limits),
+        }
+
+
 def fly_episode(sim, policy, target, limits: EpisodeLimits | None = None, log=None) -> dict:
     """Fly one episode from the simulator's start to ``target``: plan, fly the first action, replan.
 
@@ -133,66 +270,11 @@ def fly_episode(sim, policy, target, limits: EpisodeLimits | None = None, log=No
         distance (m), ``time_s``, ``fallback_steps``, planning times (ms: median, p95, every call), the
         median EFE time per candidate (us), ``target`` and ``limits``.
     """
-    lim = limits or EpisodeLimits()
+    from cogmap.envs.episode import run
+
     tgt = np.asarray(target, float)
-    start = sim.reset()
-    policy.reset(tgt, start)
-    d0 = float(np.linalg.norm(tgt - start))
-    times, positions = [0.0], [start.copy()]
-    replans, steps = 0, 0
-    plan_ms, efe_us, rules = [], [], []
-    outcome = None
-    replan_d = getattr(getattr(policy, "config", None), "replan_distance", None)
-    while True:
-        pos = sim.position.copy()
-        if float(np.linalg.norm(tgt - pos)) <= lim.success_radius:
-            outcome = "success"
-            break
-        if sim.crashed:
-            outcome = "crashed"
-            break
-        if steps >= lim.max_steps or sim.time >= lim.max_time_s:
-            outcome = "timeout"
-            break
-        if _stuck(times, positions, sim.time, lim.stuck_time_s, lim.stuck_distance):
-            outcome = "stuck"
-            break
-        policy.observe(sim.scan(), pos)
-        dec = policy.decide(pos, tgt)
-        plan_ms.append(dec.plan_ms)
-        efe_us.append(dec.plan.efe_us_per_candidate)
-        rules.append(dec.plan.rule)
-        flight = sim.fly_to(dec.waypoint, dec.speed,
-                            replan_distance=replan_d if policy.replans_in_flight else None,
-                            on_scan=policy.observe)
-        if flight.contact is not None:
-            policy.observe_contact(flight.contact)
-        sim.advance(lim.step_overhead_s)
-        steps += 1
-        replans += int(flight.replanned)
-        times.append(sim.time)
-        positions.append(sim.position.copy())
-        if log is not None:
-            log({"step": steps, "time_s": round(sim.time, 3), "x": pos[0], "y": pos[1], "z": pos[2],
-                 "wx": dec.waypoint[0], "wy": dec.waypoint[1], "wz": dec.waypoint[2],
-                 "ex": sim.position[0], "ey": sim.position[1], "ez": sim.position[2],
-                 "distance": float(np.linalg.norm(tgt - sim.position)), "collided": int(flight.collided),
-                 "replanned": int(flight.replanned), "rule": dec.plan.rule, "plan_ms": round(dec.plan_ms, 4)})
-    final = float(np.linalg.norm(tgt - sim.position))
-    success = outcome == "success"
-    pm = np.asarray(plan_ms) if plan_ms else np.zeros(1)
-    eu = np.asarray([e for e in efe_us if np.isfinite(e)])
-    return {
-        "outcome": outcome, "success": success, "stuck": outcome == "stuck", "timeout": outcome == "timeout",
-        "crashed": outcome == "crashed", "collisions": int(sim.collisions),
-        "collision_free_success": bool(success and sim.collisions == 0), "replans": replans, "steps": steps,
-        "initial_distance": d0, "final_distance": final, "time_s": round(sim.time, 3),
-        "fallback_steps": sum(r.startswith("fallback") for r in rules),
-        "plan_ms_median": float(np.median(pm)), "plan_ms_p95": float(np.percentile(pm, 95)),
-        "efe_us_per_candidate_median": float(np.median(eu)) if len(eu) else None,
-        "plan_ms": [round(float(x), 4) for x in plan_ms],
-        "target": [float(v) for v in tgt], "limits": asdict(lim),
-    }
+    episode = DroneEpisode(sim, policy, tgt, limits or EpisodeLimits(), log=log)
+    return episode.metrics(run(episode, DronePilot(policy, tgt), None))
 
 
 def summarise(episodes: list[dict]) -> dict:

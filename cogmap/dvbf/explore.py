@@ -59,6 +59,8 @@ import numpy as np
 from cogmap.envs.maze import Maze, exploration_ratio
 from cogmap.envs.maze_poses import start_pose
 from cogmap.envs.maze_sim import MazeSim
+from cogmap.envs.maze_traversal import MazeRun
+from cogmap.genmodel.contracts import Episode, EpisodePolicy
 from cogmap.planning.maze_explorers import Frontier, RandomWalk
 from cogmap.planning.mi_exploration import MIConfig
 from cogmap.planning.mi_planner import MIPlanner
@@ -361,6 +363,111 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
     return emission
 
 
+class MazePilot(EpisodePolicy):
+    """A maze explorer (:class:`MIAgent`, :class:`~cogmap.planning.maze_explorers.RandomWalk` or
+    :class:`~cogmap.planning.maze_explorers.Frontier`) as :func:`cogmap.envs.episode.run` calls
+    it: it senses the pose, scan and bump of the last step and returns the next control.
+
+    Parameters
+    ----------
+    policy : object
+        Anything with ``act(pose, scan, blocked) -> control``.
+    """
+
+    label = "maze"
+
+    def __init__(self, policy):
+        self.policy = policy
+
+    def sense(self, sim, outcome):
+        return outcome
+
+    def step(self, sensed) -> np.ndarray:
+        pose, scan, blocked = sensed
+        return self.policy.act(pose, scan, bool(blocked))
+
+
+@dataclass
+class MazeCurves:
+    """The exploration curves of a maze run.
+
+    Attributes
+    ----------
+    tiles : set of tuple
+        The Table II tiles visited.
+    ratio : list of (int, float)
+        ``(step, exploration ratio)``.
+    info : list of (int, float)
+        ``(step, KL(q(M) || p(M)))`` in nats; empty without a map.
+    """
+
+    tiles: set
+    ratio: list
+    info: list
+
+
+class MazeEpisode(Episode):
+    """One maze exploration as :func:`cogmap.envs.episode.run` drives it: the run of
+    :class:`~cogmap.envs.maze_traversal.MazeRun`, the online SLAM (if any) advanced on each step
+    and the curves recorded.
+
+    Parameters
+    ----------
+    sim : MazeSim
+        The simulator, reset at ``start``.
+    maze : Maze
+        Its maze.
+    cfg : ExploreConfig
+        ``curve_every`` (how often the curves are sampled).
+    slam : OnlineSLAM or None
+        The online SLAM fed with every step, if any.
+    steps : int
+        Time steps of the run (the start counts as step 0).
+    start : tuple
+        ``(pose, scan)`` at the start.
+    progress : callable, optional
+        Called with the step index after each step.
+    """
+
+    def __init__(self, sim, maze: Maze, cfg: ExploreConfig, slam, steps: int, start, progress=None):
+        from cogmap.genmodel.latent_map import kl_map
+
+        self.sensors, self.maze, self.cfg, self.slam, self.steps, self.progress = sim, maze, cfg, slam, steps, progress
+        pose, scan = start
+        self.record = MazeRun(sim, pose, scan)
+        self.curves = MazeCurves({tuple(r) for r in maze.tile_index(pose)}, [(0, exploration_ratio(maze, pose))], [])
+        if slam is not None:
+            self.curves.info.append((0, float(kl_map(slam.params.q_map))))
+
+    def act(self, u):
+        from cogmap.genmodel.latent_map import kl_map
+
+        maze, cfg, slam, curves = self.maze, self.cfg, self.slam, self.curves
+        pose, scan, blocked = self.record.act(u)
+        t = len(self.record.poses) - 1
+        curves.tiles.add(tuple(maze.tile_index(pose)[0]))
+        if slam is not None:
+            # a bump sensor tells the agent that a wall stopped it: the filter then sees no translation
+            # (the distance moved before the wall is not known to it)
+            slam.advance(np.array([u[0], 0.0 if blocked else u[1]])[None], scan[None])
+        if t % cfg.curve_every == 0 or t == self.steps - 1:
+            curves.ratio.append((t, len(curves.tiles) / maze.tiles**2))
+            if slam is not None and slam.t == t and t % (10 * cfg.curve_every) == 0:
+                curves.info.append((t, float(kl_map(slam.params.q_map))))
+        if self.progress is not None:
+            self.progress(t)
+        return pose, scan, blocked
+
+    def end(self) -> None:
+        from cogmap.genmodel.latent_map import kl_map
+
+        if self.slam is not None:
+            self.slam.flush()
+            last = self.steps - 1
+            if self.curves.info[-1][0] != last:
+                self.curves.info.append((last, float(kl_map(self.slam.params.q_map))))
+
+
 def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=None) -> ExploreResult:
     """Run one exploration of ``steps`` time steps (the start pose counts as step 0).
 
@@ -389,6 +496,8 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
     """
     import dataclasses
 
+    from cogmap.envs.episode import run
+
     if steps < 2:
         raise ValueError(f"explore: steps must be >= 2, got {steps}")
     sim = MazeSim(maze, noise=NOISE, seed=cfg.seed + 1)
@@ -396,11 +505,8 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
     try:
         pose = sim.reset(start_pose(maze, cfg.seed))
         scan = sim.lidar()
-        poses, controls, scans = [pose], [], [scan]
         slam = None
-        use_slam = cfg.method == "mi" or cfg.learn_map
-        if use_slam:
-            from cogmap.genmodel.latent_map import kl_map
+        if cfg.method == "mi" or cfg.learn_map:
             from cogmap.inference.online_slam import OnlineSLAM, SLAMConfig
 
             model = maze_model(maze)
@@ -415,39 +521,13 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         else:
             policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
                       else Frontier(maze, cfg, cfg.seed, sim.lidar_range))
-        ratio_curve, info_curve = [(0, exploration_ratio(maze, pose))], []
-        tiles = {tuple(r) for r in maze.tile_index(pose)}
-        if slam is not None:
-            info_curve.append((0, float(kl_map(slam.params.q_map))))
-        blocked = n_blocked = 0
-        for t in range(1, steps):
-            u = policy.act(pose, scan, bool(blocked))
-            pose, blocked = sim.step(u)
-            scan = sim.lidar()
-            n_blocked += int(blocked)
-            poses.append(pose)
-            controls.append(np.asarray(u, float))
-            scans.append(scan)
-            tiles.add(tuple(maze.tile_index(pose)[0]))
-            if slam is not None:
-                # a bump sensor tells the agent that a wall stopped it: the filter then sees no translation
-                # (the distance moved before the wall is not known to it)
-                slam.advance(np.array([u[0], 0.0 if blocked else u[1]])[None], scan[None])
-            if t % cfg.curve_every == 0 or t == steps - 1:
-                ratio_curve.append((t, len(tiles) / maze.tiles**2))
-                if slam is not None and slam.t == t and t % (10 * cfg.curve_every) == 0:
-                    info_curve.append((t, float(kl_map(slam.params.q_map))))
-            if progress is not None:
-                progress(t)
-        est = None
-        if slam is not None:
-            slam.flush()
-            est = slam.estimates[:steps].copy()
-            if info_curve[-1][0] != steps - 1:
-                info_curve.append((steps - 1, float(kl_map(slam.params.q_map))))
-        return ExploreResult(np.array(poses), np.array(controls), np.array(scans), est, ratio_curve, info_curve,
-                             getattr(policy, "plan_seconds", []), n_blocked, getattr(policy, "pulled", 0),
-                             params=slam.params if slam else None,
+        episode = MazeEpisode(sim, maze, cfg, slam, steps, (pose, scan), progress)
+        run(episode, MazePilot(policy), steps - 1, outcome=(pose, scan, 0))
+        tr, curves = episode.record.traversal(), episode.curves
+        est = slam.estimates[:steps].copy() if slam is not None else None
+        return ExploreResult(tr.poses, tr.controls, tr.scans, est, curves.ratio, curves.info,
+                             getattr(policy, "plan_seconds", []), int(tr.blocked.sum()),
+                             getattr(policy, "pulled", 0), params=slam.params if slam else None,
                              model=slam.config.model if slam else None, seconds=time.perf_counter() - tic)
     finally:
         sim.close()
