@@ -13,7 +13,7 @@ import numpy as np
 from gymnasium import spaces
 
 from .robot import MoveResult
-from .sensors import FaultSchedule
+from .sensors import FaultInjection, FaultSchedule
 
 MOVES = np.array([[1, 0], [0, 1], [-1, 0], [0, -1]])
 STAY = 4
@@ -35,7 +35,7 @@ def rooms_map(n_x: int = 2, n_y: int = 2, room: int = 4) -> np.ndarray:
     return wall
 
 
-class GridWorld:
+class GridWorld(FaultInjection):
     """Rich API mirroring :class:`NavSim` on a discrete grid (no physics client).
 
     Poses are ``(col, row, heading)`` ints, heading 0..3 = east, north, west, south; actions 0..3
@@ -249,20 +249,6 @@ class GridWorld:
             Free-cell index.
         """
         self.cell = int(cell)
-
-    def inject_fault(self, stream: str, start_step: int, length: int) -> None:
-        """Drop a stream for steps ``[start_step, start_step + length)``.
-
-        Parameters
-        ----------
-        stream : str
-            ``"lidar"``, ``"camera"`` or ``"odometry"``.
-        start_step : int
-            First step without data.
-        length : int
-            Number of steps without data.
-        """
-        self.faults.add(stream, start_step, length)
 
 
 class GridWorldEnv(gym.Env):

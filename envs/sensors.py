@@ -46,3 +46,23 @@ class FaultSchedule:
     def clear(self) -> None:
         for v in self.windows.values():
             v.clear()
+
+
+class FaultInjection:
+    """Sensor dropouts for a simulator that keeps a :class:`FaultSchedule` as ``faults``."""
+
+    faults: FaultSchedule
+
+    def inject_fault(self, stream: str, start_step: int, length: int) -> None:
+        """Drop a sensor stream for steps ``[start_step, start_step + length)``.
+
+        Parameters
+        ----------
+        stream : str
+            ``"lidar"``, ``"camera"`` or ``"odometry"``.
+        start_step : int
+            First step without data.
+        length : int
+            Number of steps without data.
+        """
+        self.faults.add(stream, start_step, length)

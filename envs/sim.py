@@ -27,7 +27,7 @@ from .robot import (
     odom_to_world,
     straight_move,
 )
-from .sensors import FaultSchedule, lidar_angles, obstacle_signal
+from .sensors import FaultInjection, FaultSchedule, lidar_angles, obstacle_signal
 
 
 @dataclass(frozen=True)
@@ -87,7 +87,7 @@ class SimConfig:
         return 360.0 / self.n_views
 
 
-class NavSim:
+class NavSim(FaultInjection):
     """A layout in pybullet with a kinematic disc robot, LiDAR, panoramic camera and odometry.
 
     Parameters
@@ -375,20 +375,6 @@ class NavSim:
         """
         self.layout.shape(name)  # raises on unknown names
         self.scheduled.append((int(at_step), name, tuple(xy), yaw))
-
-    def inject_fault(self, stream: str, start_step: int, length: int) -> None:
-        """Drop a sensor stream for steps ``[start_step, start_step + length)``.
-
-        Parameters
-        ----------
-        stream : str
-            ``"lidar"``, ``"camera"`` or ``"odometry"``.
-        start_step : int
-            First step without data.
-        length : int
-            Number of steps without data.
-        """
-        self.faults.add(stream, start_step, length)
 
     # ----------------------------------------------------------------- sensors
     def lidar_angles(self) -> np.ndarray:

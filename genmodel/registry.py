@@ -132,26 +132,39 @@ def passes(test: Callable[[object], bool], model) -> bool:
 
 class Registry:
     """Named entries of one kind, each checked against its contract when added; the names present
-    when :meth:`seal` is called are built in (they can be neither replaced nor removed).
+    when :meth:`seal` is called are built in (they can be neither replaced nor removed). An entry
+    may declare the models it accepts (:meth:`accepting`).
+
+    Every registry of the toolkit is one of these (inference schemes, planners, encoders, agents,
+    studies); their module functions (``register_planner``, ``get_planner``, ...) are its methods.
 
     Parameters
     ----------
     kind : str
-        What is registered (``"agent"``, ``"study"``), for the messages.
+        What is registered (``"agent"``, ``"planner"``), for the messages.
     func : str
         The registering function's name, for the messages (``"register_agent"``).
     protocol : type, optional
         The contract of :mod:`cogmap.genmodel.contracts` every entry must meet.
     missing : type, optional
         The exception :meth:`get` raises for an unknown name, default ``KeyError``.
+    expected : str, optional
+        What an entry must be when it has to be callable (``"a callable factory(config) ->
+        Encoder"``); None (the default) accepts any object.
+    check : callable, optional
+        ``check(name, entry)`` raising on a mistake of this kind the contract cannot see (run
+        before the other checks).
     """
 
-    def __init__(self, kind: str, func: str, protocol=None, missing: type[Exception] = KeyError):
-        self.kind, self.func, self.protocol, self.missing = kind, func, protocol, missing
+    def __init__(self, kind: str, func: str, protocol=None, missing: type[Exception] = KeyError,
+                 expected: str | None = None, check: Callable[[str, object], None] | None = None):
+        self.kind, self.func, self.protocol, self.missing, self.expected = kind, func, protocol, missing, expected
+        self.check = check
         self._entries: dict = {}
+        self._accepts: dict[str, Callable[[object], bool]] = {}
         self._builtin: frozenset[str] = frozenset()
 
-    def add(self, name: str, entry, overwrite: bool = False):
+    def add(self, name: str, entry, overwrite: bool = False, accepts=None):
         """Register ``entry`` under ``name`` and return it.
 
         Parameters
@@ -161,7 +174,10 @@ class Registry:
         entry : object
             What is registered.
         overwrite : bool, optional
-            Replace an entry registered earlier under ``name`` (built-in ones cannot be replaced).
+            Replace an entry registered earlier under ``name`` (built-in ones cannot be replaced;
+            registering the very same entry again is always allowed).
+        accepts : type, tuple of types or callable, optional
+            The models the entry handles (:func:`accepts_test`); default every model.
 
         Returns
         -------
@@ -173,17 +189,61 @@ class Registry:
         ValueError
             Empty name, a built-in name, or a taken name without ``overwrite``.
         TypeError
-            ``entry`` does not meet the contract.
+            ``entry`` is not callable (when it must be), does not meet the contract, or
+            ``accepts`` is none of the forms above.
         """
         check_name(self.func, name)
-        if self.protocol is not None:
-            check_conforms(self.func, self.kind, name, entry, self.protocol)
-        if name in self._builtin:
-            raise ValueError(f"{self.func}: '{name}' is a built-in {self.kind}; choose another name")
-        if name in self._entries and not overwrite:
-            raise ValueError(f"{self.func}: a {self.kind} named '{name}' exists (pass overwrite=True)")
+        test = accepts_test(f"{self.func}('{name}')", accepts)
+        if self.check is not None:
+            self.check(name, entry)
+        if self.expected is not None:
+            check_entry(self.func, self.kind, name, entry, self._entries, self._builtin, overwrite,
+                        expected=self.expected, protocol=self.protocol)
+        else:
+            if self.protocol is not None:
+                check_conforms(self.func, self.kind, name, entry, self.protocol)
+            again = self._entries.get(name) is entry
+            if name in self._builtin and not again:
+                raise ValueError(f"{self.func}: '{name}' is a built-in {self.kind}; choose another name")
+            if name in self._entries and not overwrite and not again:
+                raise ValueError(f"{self.func}: a {self.kind} named '{name}' exists (pass overwrite=True)")
         self._entries[name] = entry
+        self._accepts[name] = test
         return entry
+
+    def register(self, name: str, entry=None, *, accepts=None, overwrite: bool = False):
+        """Register ``entry`` under ``name``; without ``entry``, a decorator that registers its
+        argument (``@register_planner("mine")``).
+
+        Parameters
+        ----------
+        name : str
+            Non-empty name.
+        entry : object, optional
+            What is registered; omit to get a decorator.
+        accepts : type, tuple of types or callable, optional
+            The models the entry handles (a model type, a tuple of them, or a test
+            ``accepts(model) -> bool``); default every model.
+        overwrite : bool, optional
+            Replace an entry registered earlier under ``name`` (built-in ones cannot be replaced).
+
+        Returns
+        -------
+        object
+            ``entry``, or the decorator.
+
+        Raises
+        ------
+        ValueError, TypeError
+            As :meth:`add`.
+        """
+        check_name(self.func, name)
+        accepts_test(f"{self.func}('{name}')", accepts)
+
+        def _add(e):
+            return self.add(name, e, overwrite, accepts)
+
+        return _add if entry is None else _add(entry)
 
     def remove(self, name: str) -> None:
         """Remove the entry registered under ``name``.
@@ -198,13 +258,14 @@ class Registry:
         ValueError
             For a built-in name.
         KeyError
-            If nothing has that name.
+            If nothing has that name (the message lists the registered names).
         """
         if name in self._builtin:
             raise ValueError(f"'{name}' is a built-in {self.kind} and cannot be removed")
         if name not in self._entries:
-            raise KeyError(f"no {self.kind} named '{name}'")
+            raise KeyError(f"no {self.kind} named '{name}' (available: {', '.join(self.available())})")
         del self._entries[name]
+        self._accepts.pop(name, None)
 
     def get(self, name: str):
         """The entry registered under ``name``.
@@ -226,7 +287,7 @@ class Registry:
         try:
             return self._entries[name]
         except (KeyError, TypeError):
-            raise self.missing(f"unknown {self.kind} {name!r}; choose from {self.names()}") from None
+            raise self.missing(f"unknown {self.kind} {name!r} (available: {', '.join(self.available())})") from None
 
     def names(self) -> tuple[str, ...]:
         """The registered names, in registration order.
@@ -236,6 +297,51 @@ class Registry:
         tuple of str
         """
         return tuple(self._entries)
+
+    def available(self) -> tuple[str, ...]:
+        """The registered names, sorted.
+
+        Returns
+        -------
+        tuple of str
+        """
+        return tuple(sorted(self._entries))
+
+    def accepts(self, name: str, model) -> bool:
+        """Whether the entry registered under ``name`` handles ``model`` (its ``accepts``).
+
+        Parameters
+        ----------
+        name : str
+            A registered name.
+        model : object
+            Any model.
+
+        Returns
+        -------
+        bool
+
+        Raises
+        ------
+        Exception
+            ``missing`` for an unknown name.
+        """
+        self.get(name)
+        return passes(self._accepts[name], model)
+
+    def accepting(self, model) -> tuple[str, ...]:
+        """The registered names (sorted) whose entries handle ``model``.
+
+        Parameters
+        ----------
+        model : object
+            Any model.
+
+        Returns
+        -------
+        tuple of str
+        """
+        return tuple(n for n in self.available() if passes(self._accepts[n], model))
 
     def seal(self) -> None:
         """Make every name registered so far a built-in one."""

@@ -2,167 +2,32 @@
 
 A scheme is any callable ``scheme(model, prior, observations, actions=None, **options)``
 returning ``(posterior, info)`` (see :mod:`cogmap.inference.base`). Users add their own with
-:func:`register` without touching this package.
+:func:`register` without touching this package; the registry checks each one against the
+contract (:class:`cogmap.genmodel.contracts.InferenceScheme`) when it is registered.
 """
 
 from __future__ import annotations
 
 import inspect
-from collections.abc import Callable
 
-from cogmap.genmodel.contracts import InferenceScheme, check_conforms
-from cogmap.genmodel.registry import accepts_test, passes
+from cogmap.genmodel.contracts import InferenceScheme
+from cogmap.genmodel.registry import Registry
 
 #: the arguments every scheme takes; anything else it accepts is one of its options
 CALL = ("model", "prior", "observations", "actions")
 
-_SCHEMES: dict[str, Callable] = {}
-_ACCEPTS: dict[str, Callable[[object], bool]] = {}
-
-
-def register(name: str, fn: Callable | None = None, *, accepts=None, overwrite: bool = False):
-    """Register an inference scheme under ``name``; usable as a decorator (``@register("mine")``).
-
-    A scheme is any callable ``scheme(model, prior, observations, actions=None, **options)``
-    returning ``(posterior, info)`` (:class:`cogmap.genmodel.contracts.InferenceScheme`).
-
-    Parameters
-    ----------
-    name : str
-        Non-empty name.
-    fn : callable, optional
-        The scheme; omit to get a decorator.
-    accepts : type, tuple of types or callable, optional
-        The models the scheme handles: a model type (or tuple of them), or a test
-        ``accepts(model) -> bool``. :func:`accepting` and ``compare-inference`` offer the scheme
-        only for such models. Default: every model.
-    overwrite : bool, optional
-        Whether to replace another scheme of the same name, default False.
-
-    Returns
-    -------
-    callable
-        ``fn`` itself, or a decorator that registers and returns its argument.
-
-    Raises
-    ------
-    ValueError
-        For an empty name, or a name taken by another scheme without ``overwrite``.
-    TypeError
-        If the scheme is not callable, cannot be called as ``scheme(model, prior, observations)``,
-        or ``accepts`` is neither a type nor a callable.
-    """
-    if not isinstance(name, str) or not name:
-        raise ValueError("register: name must be a non-empty string")
-    test = accepts_test(f"register('{name}')", accepts)
-
-    def _add(f: Callable) -> Callable:
-        if not callable(f):
-            raise TypeError(f"register('{name}'): expected a callable, got {type(f).__name__}")
-        check_conforms("register", "inference scheme", name, f, InferenceScheme)
-        if name in _SCHEMES and not overwrite and _SCHEMES[name] is not f:
-            raise ValueError(f"register: a scheme named '{name}' exists (pass overwrite=True)")
-        _SCHEMES[name] = f
-        _ACCEPTS[name] = test
-        return f
-
-    return _add if fn is None else _add(fn)
-
-
-def unregister(name: str) -> None:
-    """Remove the scheme registered under ``name``.
-
-    Parameters
-    ----------
-    name : str
-        Registered name.
-
-    Raises
-    ------
-    KeyError
-        If no scheme has that name.
-    """
-    if name not in _SCHEMES:
-        raise KeyError(f"no inference scheme named '{name}'")
-    del _SCHEMES[name]
-    _ACCEPTS.pop(name, None)
-
-
-def get(name: str) -> Callable:
-    """The scheme registered under ``name``.
-
-    Parameters
-    ----------
-    name : str
-        Registered name (``available()`` lists them).
-
-    Returns
-    -------
-    callable
-        ``scheme(model, prior, observations, actions=None, **options) -> (posterior, info)``.
-
-    Raises
-    ------
-    KeyError
-        If no scheme has that name (the message lists the available ones).
-    """
-    try:
-        return _SCHEMES[name]
-    except KeyError:
-        raise KeyError(f"unknown inference scheme '{name}' (available: {available()})") from None
-
-
-def available() -> tuple[str, ...]:
-    """Names of the registered schemes.
-
-    Returns
-    -------
-    tuple of str
-        Sorted names.
-    """
-    return tuple(sorted(_SCHEMES))
-
-
-def accepts(name: str, model) -> bool:
-    """Whether the scheme registered under ``name`` handles ``model`` (its ``accepts``).
-
-    Parameters
-    ----------
-    name : str
-        Registered name.
-    model : object
-        A model (``Model``, ``ParticleModel``, ``KernelBeliefModel``, ...).
-
-    Returns
-    -------
-    bool
-
-    Raises
-    ------
-    KeyError
-        If no scheme has that name.
-    """
-    get(name)
-    return _test(name, model)
-
-
-def accepting(model) -> tuple[str, ...]:
-    """Names of the registered schemes that handle ``model`` (sorted).
-
-    Parameters
-    ----------
-    model : object
-        A model.
-
-    Returns
-    -------
-    tuple of str
-    """
-    return tuple(n for n in available() if _test(n, model))
-
-
-def _test(name: str, model) -> bool:
-    return passes(_ACCEPTS[name], model)
+#: the registered schemes; ``register(name, fn, *, accepts=None, overwrite=False)`` (a
+#: decorator without ``fn``), ``unregister``, ``get``, ``available``, ``accepts(name, model)`` and
+#: ``accepting(model)`` are its methods. ``accepts`` names the models a scheme handles (a model
+#: type, a tuple of them or a test ``accepts(model) -> bool``): :func:`accepting` and
+#: ``compare-inference`` offer the scheme only for such models.
+SCHEMES = Registry("inference scheme", "register", protocol=InferenceScheme, expected="a callable")
+register = SCHEMES.register
+unregister = SCHEMES.remove
+get = SCHEMES.get
+available = SCHEMES.available
+accepts = SCHEMES.accepts
+accepting = SCHEMES.accepting
 
 
 def options(name: str) -> tuple[str, ...] | None:

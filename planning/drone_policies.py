@@ -169,10 +169,8 @@ class PotentialField(DronePolicy):
 
         Parameters
         ----------
-        target : array_like, optional
-            ``(3,)`` target position, metres.
-        start : array_like, optional
-            ``(3,)`` start position, metres.
+        target, start : array_like, optional
+            As in :meth:`DronePolicy.reset`.
         """
         self.voxels = VoxelMap()
 

@@ -31,7 +31,7 @@ import numpy as np
 from cogmap.genmodel import contracts
 from cogmap.genmodel.drone_beliefs import entropy
 from cogmap.genmodel.model import Model
-from cogmap.genmodel.registry import accepts_test, check_entry, check_name, passes
+from cogmap.genmodel.registry import Registry
 
 from .arrays import PlanningArrays
 from .drone_lookahead import LookaheadConfig, plan_sequence
@@ -89,108 +89,16 @@ class Plan(NamedTuple):
 
 Planner = Callable[..., Plan]
 
-_PLANNERS: dict[str, Planner] = {}
-_ACCEPTS: dict[str, Callable[[object], bool]] = {}
-
-
-def register_planner(name: str, fn: Planner | None = None, *, accepts=None, overwrite: bool = False):
-    """Register planner ``fn`` under ``name``; usable as a decorator (``@register_planner("mine")``).
-
-    Parameters
-    ----------
-    name : str
-        The name ``cogmap.loop.init(planner=name)`` will use.
-    fn : callable, optional
-        ``fn(model, qs, objective, settings) -> Plan`` (module docstring). Omitted: returns a
-        decorator.
-    accepts : type, tuple of types or callable, optional
-        The models it plans with (a type, types, or ``accepts(model) -> bool``); default every model.
-    overwrite : bool
-        Replace a planner registered under ``name`` (the built-in ``"enumerate"`` and
-        ``"mcts"`` cannot be replaced).
-
-    Returns
-    -------
-    callable
-        ``fn`` (or the decorator registering it).
-
-    Raises
-    ------
-    ValueError
-        Empty name, a built-in name, or a name already taken without ``overwrite``.
-    TypeError
-        ``fn`` is not callable or cannot be called as ``fn(model, qs, objective, settings)``
-        (:class:`cogmap.genmodel.contracts.Planner`), or ``accepts`` is neither a type nor a callable.
-    """
-    check_name("register_planner", name)
-    test = accepts_test(f"register_planner('{name}')", accepts)
-
-    def _add(f: Planner) -> Planner:
-        check_entry("register_planner", "planner", name, f, _PLANNERS, BUILTIN, overwrite,
-                    protocol=contracts.Planner)
-        _PLANNERS[name] = f
-        _ACCEPTS[name] = test
-        return f
-
-    return _add if fn is None else _add(fn)
-
-
-def unregister_planner(name: str) -> None:
-    """Remove a registered planner.
-
-    Parameters
-    ----------
-    name : str
-        A name given to :func:`register_planner`.
-
-    Raises
-    ------
-    KeyError
-        No planner has that name (the message lists the registered ones).
-    ValueError
-        ``name`` is a built-in planner.
-    """
-    if name in BUILTIN:
-        raise ValueError(f"'{name}' is a built-in planner and cannot be removed")
-    if name not in _PLANNERS:
-        raise KeyError(f"no planner named '{name}' (available: {', '.join(available_planners())})")
-    del _PLANNERS[name]
-    _ACCEPTS.pop(name, None)
-
-
-def get_planner(name: str) -> Planner:
-    """The planner registered as ``name``.
-
-    Parameters
-    ----------
-    name : str
-        A built-in (``"enumerate"``, ``"mcts"``) or registered planner name.
-
-    Returns
-    -------
-    callable
-        ``planner(model, qs, objective, settings) -> Plan``.
-
-    Raises
-    ------
-    KeyError
-        Unknown name; the message lists the registered ones.
-    """
-    try:
-        return _PLANNERS[name]
-    except (KeyError, TypeError):
-        raise KeyError(f"unknown planner {name!r} (available: {', '.join(available_planners())})") from None
-
-
-def available_planners() -> tuple[str, ...]:
-    """Names of every planner the loop can use.
-
-    Returns
-    -------
-    tuple of str
-        Sorted names, the built-in ones included.
-    """
-    return tuple(sorted(_PLANNERS))
+#: the registered planners; ``register_planner(name, fn, *, accepts=None, overwrite=False)``
+#: (a decorator without ``fn``; ``accepts`` names the models it plans with), ``unregister_planner``,
+#: ``get_planner``, ``available_planners`` and ``accepting_planners(model)`` are its methods. The
+#: built-in ``enumerate``, ``mcts`` and ``drone`` can be neither replaced nor removed.
+PLANNERS = Registry("planner", "register_planner", protocol=contracts.Planner, expected="a callable")
+register_planner = PLANNERS.register
+unregister_planner = PLANNERS.remove
+get_planner = PLANNERS.get
+available_planners = PLANNERS.available
+accepting_planners = PLANNERS.accepting
 
 
 # -- the two built-in planners -----------------------------------------------------------------
@@ -226,12 +134,8 @@ def mcts_planner(model, qs, objective, settings: PlanSettings) -> Plan:
 
     Parameters
     ----------
-    model : Model or PlanningArrays
-        The model to plan with.
-    qs : list of numpy.ndarray
-        Current belief, one ``(n_f,)`` array per factor.
-    objective : Objective
-        Per-step expected free energy.
+    model, qs, objective
+        As for :func:`enumerate_planner`.
     settings : PlanSettings
         ``settings.mcts`` (default: ``MCTSConfig(gamma=settings.gamma)``) and the RNG.
 
@@ -295,27 +199,11 @@ def drone_planner(model: DroneScene, qs, objective, settings):
     return Plan(plan.actions[0], np.asarray(G), None, plan.actions, plan)
 
 
-def accepting_planners(model) -> tuple[str, ...]:
-    """Names of the planners that plan with ``model`` (their ``accepts``), sorted.
-
-    Parameters
-    ----------
-    model : object
-        A compiled :class:`~cogmap.genmodel.Model`, :class:`~.arrays.PlanningArrays`, a
-        :class:`~.drone_planner.DroneScene`, or a user's model.
-
-    Returns
-    -------
-    tuple of str
-    """
-    return tuple(n for n in available_planners() if passes(_ACCEPTS[n], model))
-
-
 BUILTIN = {"enumerate": enumerate_planner, "mcts": mcts_planner, "drone": drone_planner}
-_PLANNERS.update(BUILTIN)
-_ACCEPTS.update({"enumerate": accepts_test("planners", (Model, PlanningArrays)),
-                 "mcts": accepts_test("planners", (Model, PlanningArrays)),
-                 "drone": accepts_test("planners", DroneScene)})
+for _name, _accepts in (("enumerate", (Model, PlanningArrays)), ("mcts", (Model, PlanningArrays)),
+                        ("drone", DroneScene)):
+    PLANNERS.add(_name, BUILTIN[_name], accepts=_accepts)
+PLANNERS.seal()
 
 __all__ = ["Plan", "PlanSettings", "accepting_planners", "available_planners", "drone_planner", "enumerate_planner",
            "get_planner", "mcts_planner", "register_planner", "unregister_planner"]

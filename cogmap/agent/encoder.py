@@ -16,13 +16,11 @@ panoramas costs a handful of OpenCV calls.
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 import numpy as np
 
 from cogmap.genmodel import contracts
 from cogmap.genmodel.contracts import Encoder
-from cogmap.genmodel.registry import check_entry, check_name
+from cogmap.genmodel.registry import Registry
 
 C1 = (0.01 * 255) ** 2
 C2 = (0.03 * 255) ** 2
@@ -444,80 +442,23 @@ def _ssim_encoder(config) -> SSIMEncoder:
     return SSIMEncoder(config.ssim_threshold)
 
 
-_BUILTIN_ENCODERS = {"ssim": _ssim_encoder}
-_ENCODERS: dict[str, Callable] = dict(_BUILTIN_ENCODERS)
+def _not_an_encoder(name: str, factory) -> None:
+    if callable(factory) and isinstance(factory, Encoder):
+        raise TypeError(f"register_encoder('{name}'): expected a callable factory(config) -> Encoder, got the "
+                        f"encoder {type(factory).__name__} itself (register lambda config: ... returning a new one)")
 
 
-def register_encoder(name: str, factory: Callable | None = None, *, overwrite: bool = False):
-    """Register an encoder factory under ``name``; ``AgentConfig(encoder=name)`` then selects it.
-
-    Parameters
-    ----------
-    name : str
-        The name for ``AgentConfig.encoder``.
-    factory : callable, optional
-        ``factory(config: AgentConfig) -> Encoder``, called once per agent. Omitted: returns a
-        decorator.
-    overwrite : bool
-        Replace a factory registered under ``name`` (the built-in ``"ssim"`` cannot be replaced).
-
-    Returns
-    -------
-    callable
-        ``factory`` (or the decorator registering it).
-
-    Raises
-    ------
-    ValueError
-        Empty or built-in name, or a name already taken without ``overwrite``.
-    TypeError
-        ``factory`` is not callable, or is an encoder itself rather than a factory.
-    """
-    check_name("register_encoder", name)
-
-    def _add(f: Callable) -> Callable:
-        if callable(f) and isinstance(f, Encoder):
-            raise TypeError(f"register_encoder('{name}'): expected a callable factory(config) -> Encoder, got the "
-                            f"encoder {type(f).__name__} itself (register lambda config: ... returning a new one)")
-        check_entry("register_encoder", "encoder", name, f, _ENCODERS, _BUILTIN_ENCODERS, overwrite,
-                    expected="a callable factory(config) -> Encoder", protocol=contracts.EncoderFactory)
-        _ENCODERS[name] = f
-        return f
-
-    return _add if factory is None else _add(factory)
-
-
-def unregister_encoder(name: str) -> None:
-    """Remove a registered encoder factory.
-
-    Parameters
-    ----------
-    name : str
-        A name given to :func:`register_encoder`.
-
-    Raises
-    ------
-    KeyError
-        No encoder has that name (the message lists the registered ones).
-    ValueError
-        ``name`` is a built-in encoder.
-    """
-    if name in _BUILTIN_ENCODERS:
-        raise ValueError(f"'{name}' is a built-in encoder and cannot be removed")
-    if name not in _ENCODERS:
-        raise KeyError(f"no encoder named {name!r} (available: {', '.join(available_encoders())})")
-    del _ENCODERS[name]
-
-
-def available_encoders() -> tuple[str, ...]:
-    """Names ``AgentConfig.encoder`` accepts.
-
-    Returns
-    -------
-    tuple of str
-        Sorted names, the built-in ``"ssim"`` included.
-    """
-    return tuple(sorted(_ENCODERS))
+#: the registered encoder factories ``factory(config: AgentConfig) -> Encoder`` (called once per
+#: agent); ``register_encoder(name, factory, *, overwrite=False)`` (``AgentConfig(encoder=name)``
+#: then selects it), ``unregister_encoder`` and ``available_encoders`` are its methods. The
+#: built-in ``"ssim"`` can be neither replaced nor removed.
+ENCODERS = Registry("encoder", "register_encoder", protocol=contracts.EncoderFactory,
+                    expected="a callable factory(config) -> Encoder", check=_not_an_encoder)
+ENCODERS.add("ssim", _ssim_encoder)
+ENCODERS.seal()
+register_encoder = ENCODERS.register
+unregister_encoder = ENCODERS.remove
+available_encoders = ENCODERS.available
 
 
 def make_encoder(name: str, config) -> Encoder:
@@ -542,11 +483,7 @@ def make_encoder(name: str, config) -> Encoder:
     TypeError
         The factory's result lacks a member of the :class:`Encoder` protocol.
     """
-    try:
-        factory = _ENCODERS[name]
-    except (KeyError, TypeError):
-        raise KeyError(f"unknown encoder {name!r} (available: {', '.join(available_encoders())})") from None
-    encoder = factory(config)
+    encoder = ENCODERS.get(name)(config)
     check_encoder(encoder)
     return encoder
 

@@ -181,17 +181,5 @@ class OracleTour(BaselinePolicy):
 
         return next_waypoint(self.path, pos, cfg.step_length, visible), "world"
 
-    def believed_pose(self, sim) -> np.ndarray:
-        """The true position (the oracle knows it).
-
-        Parameters
-        ----------
-        sim : NavSim
-            The simulator.
-
-        Returns
-        -------
-        numpy.ndarray
-            ``(2,)`` float, metres, world frame.
-        """
+    def believed_pose(self, sim) -> np.ndarray:  # the true position, world frame: the oracle knows it
         return sim.true_pose()[:2]

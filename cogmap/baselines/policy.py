@@ -71,7 +71,7 @@ class BaselinePolicy:
         Parameters
         ----------
         sim : NavSim
-            The simulator.
+            The simulator (its odometry is read).
 
         Returns
         -------

@@ -133,10 +133,8 @@ class DroneAgent(DronePolicy):
 
         Parameters
         ----------
-        target : array_like, optional
-            ``(3,)`` target position, metres.
-        start : array_like, optional
-            ``(3,)`` start position, metres.
+        target, start : array_like, optional
+            As in :meth:`cogmap.planning.drone_policies.DronePolicy.reset`.
         """
         self.voxels = VoxelMap(memory=self.config.scan_memory)
         self.beliefs = None

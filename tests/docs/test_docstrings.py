@@ -1,12 +1,12 @@
 """Every public name carries a numpy-style docstring that names its parameters and what it returns.
 
 Public names: ``__all__`` of the library and agent-layer packages (or, without ``__all__``, the
-callables their ``__init__`` re-exports), plus the public functions and classes defined in
-``cogmap.loop`` and ``cogmap.harness``; for each class, its public methods. A callable with
-parameters (other than ``self``/``cls``) needs a ``Parameters`` section (``Attributes`` also counts
-for a class, e.g. a dataclass); a function whose own body has ``return <value>`` needs ``Returns``
-(``Yields`` for a generator). Properties (also cached ones) need a docstring only. Methods inherited
-from cogmap base classes are checked too.
+callables their ``__init__`` re-exports; a registry's bound methods among them), plus the public
+functions and classes defined in ``cogmap.loop`` and ``cogmap.harness``; for each class, its
+public methods. A callable with parameters (other than ``self``/``cls``) needs a ``Parameters``
+section (``Attributes`` also counts for a class, e.g. a dataclass); a function whose own body has
+``return <value>`` needs ``Returns`` (``Yields`` for a generator). Properties (also cached ones)
+need a docstring only. Methods inherited from cogmap base classes are checked too.
 
 Run ``python tests/docs/test_docstrings.py`` to print every problem.
 """
@@ -63,7 +63,7 @@ def public_names() -> dict[str, object]:
             names = [n for n in vars(pkg) if not n.startswith("_")]
         for name in names:
             obj = _unwrap(getattr(pkg, name))
-            if inspect.isclass(obj) or inspect.isfunction(obj):
+            if inspect.isclass(obj) or inspect.isfunction(obj) or inspect.ismethod(obj):  # a registry's method too
                 found[f"{pkg_name}.{name}"] = obj
     for mod_name in MODULES:
         mod = importlib.import_module(mod_name)
@@ -178,7 +178,12 @@ def problems() -> list[str]:
         if id(obj) in seen or _pending(obj):  # an object re-exported under several names is checked once
             continue
         seen.add(id(obj))
-        out += _check_class(qualname, obj) if inspect.isclass(obj) else _check_function(qualname, obj, bound=False)
+        if inspect.isclass(obj):
+            out += _check_class(qualname, obj)
+        elif inspect.ismethod(obj):
+            out += _check_function(qualname, obj.__func__, bound=True)
+        else:
+            out += _check_function(qualname, obj, bound=False)
     return out
 
 
