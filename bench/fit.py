@@ -17,43 +17,18 @@ from __future__ import annotations
 import argparse
 import time
 
-import numpy as np
-
-from cogmap.genmodel import Factor, Modality, ModelSpec, compile
-from cogmap.genmodel.demo_models import aliased_room
+from cogmap.genmodel.demo_models import aliased_room, room_model, room_walk
 from cogmap.inference.fit import fit, surprise_bits
-
-
-def walk(A, B, T, seed):
-    rng = np.random.default_rng(seed)
-    s, obs, acts = int(rng.integers(B.shape[0])), [], []
-    for t in range(T):
-        if t:
-            acts.append(int(rng.integers(B.shape[2])))
-            s = int(np.argmax(B[:, s, acts[-1]]))
-        obs.append([int(rng.choice(A.shape[0], p=A[:, s]))])
-    return obs, acts
-
-
-def room(A, B, conc=None):
-    """The true model, or (``conc`` given) a learner of B with prior counts ``conc`` per entry."""
-    n, U = B.shape[1], B.shape[2]
-    spec = ModelSpec([Factor("place", n, num_controls=U)], [Modality("view", A.shape[0], ("place",))],
-                     A={"view": A}, B={"place": B if conc is None else np.full((n, n, U), 1 / n)},
-                     D={"place": np.full(n, 1 / n)})
-    if conc is not None:
-        spec.pB["place"] = np.full((n, n, U), conc)
-    return compile(spec)
 
 
 def timing(steps: int, iterations: int) -> None:
     print(f"{'places':>7} {'us per step and iteration':>27} {'per restart of 4':>17}")
     for side in (4, 5, 10, 20):
         A, B, _ = aliased_room(side, noise=0.05)
-        obs, acts = walk(A, B, steps, 0)
+        obs, acts, _ = room_walk(A, B, steps, 0)
         row = []
         for restarts in (1, 4):
-            model = room(A, B, conc=0.1)
+            model = room_model(A, B, conc=0.1)
             t0 = time.perf_counter()
             res = fit(model, [(obs, acts)], learn_A=False, learn_B=True, iterations=iterations, tol=0.0,
                       init_counts=1.0, seed=0, restarts=restarts)
@@ -65,13 +40,13 @@ def target(steps: int) -> None:
     side, views = 5, 8
     A, B, _ = aliased_room(side, views, noise=0.05)
     n = side * side
-    train, held_out = walk(A, B, steps, 0), walk(A, B, 2000, 1)
-    true_bits = surprise_bits(room(A, B), *held_out)
+    train, held_out = room_walk(A, B, steps, 0)[:2], room_walk(A, B, 2000, 1)[:2]
+    true_bits = surprise_bits(room_model(A, B), *held_out)
     print(f"\n{side}x{side} room, {views} views, {steps}-step walk: true model {true_bits:.3f} bits/step held out")
     print(f"{'prior':>7} {'fit':>28} {'final F (nats) per restart':>34} {'learned bits':>13} {'/ true':>7} {'s':>6}")
     for conc in (0.1, 1 / n):
         for name, kw in (("plain EM", {}), ("4 restarts, annealed", dict(restarts=4, anneal_iterations=40))):
-            model = room(A, B, conc=conc)
+            model = room_model(A, B, conc=conc)
             t0 = time.perf_counter()
             res = fit(model, [train], learn_A=False, learn_B=True, iterations=200, init_counts=1.0, seed=0, **kw)
             bits = surprise_bits(model, *held_out)

@@ -118,7 +118,7 @@ def sweep(sim, tracker: CoverageTracker) -> None:
     Parameters
     ----------
     sim : NavSim
-        The simulator.
+        The simulator, whose LiDAR hits are read.
     tracker : CoverageTracker
         The run's coverage (:func:`coverage_tracker`).
     """
@@ -132,7 +132,7 @@ def execute(sim, command: Command) -> bool:
     Parameters
     ----------
     sim : NavSim
-        The simulator.
+        The simulator that moves.
     command : Command
         The decision; ``waypoint`` None means stay.
 

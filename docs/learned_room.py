@@ -16,8 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from cogmap.genmodel import Factor, Modality, ModelSpec, compile
-from cogmap.genmodel.demo_models import ROOM_MOVES, aliased_room
+from cogmap.genmodel.demo_models import ROOM_MOVES, aliased_room, room_model, room_walk
 from cogmap.inference.exact import exact
 from cogmap.inference.fit import fit, surprise_bits
 
@@ -25,27 +24,6 @@ OUT = Path(__file__).resolve().parent / "img" / "learning"
 SIDE, VIEWS, STEPS = 5, 8, 10000
 
 
-def walk(A, B, T, seed):
-    rng = np.random.default_rng(seed)
-    s, obs, acts, places = int(rng.integers(B.shape[0])), [], [], []
-    for t in range(T):
-        if t:
-            acts.append(int(rng.integers(B.shape[2])))
-            s = int(np.argmax(B[:, s, acts[-1]]))
-        places.append(s)
-        obs.append([int(rng.choice(A.shape[0], p=A[:, s]))])
-    return obs, acts, np.array(places)
-
-
-def room(A, B, conc=None):
-    """The true model, or (``conc`` given) a learner of B with prior counts ``conc`` per entry."""
-    n, U = B.shape[1], B.shape[2]
-    spec = ModelSpec([Factor("place", n, num_controls=U)], [Modality("view", A.shape[0], ("place",))],
-                     A={"view": A}, B={"place": B if conc is None else np.full((n, n, U), 1 / n)},
-                     D={"place": np.full(n, 1 / n)})
-    if conc is not None:
-        spec.pB["place"] = np.full((n, n, U), conc)
-    return compile(spec)
 
 
 def place_of_states(model, obs, acts, places):
@@ -92,14 +70,14 @@ def main() -> None:
 
     A, B, label = aliased_room(SIDE, VIEWS, noise=0.05)
     n = SIDE * SIDE
-    obs, acts, places = walk(A, B, STEPS, 0)
-    held_obs, held_acts, _ = walk(A, B, 2000, 1)
-    true_bits = surprise_bits(room(A, B), held_obs, held_acts)
+    obs, acts, places = room_walk(A, B, STEPS, 0)
+    held_obs, held_acts, _ = room_walk(A, B, 2000, 1)
+    true_bits = surprise_bits(room_model(A, B), held_obs, held_acts)
     fig, axes = plt.subplots(1, 2, figsize=(9, 4.6))
     summary = {"true_bits": true_bits}
     fits = (("plain EM", {}), ("4 restarts, annealed", dict(restarts=4, anneal_iterations=40)))
     for ax, (name, kw) in zip(axes, fits, strict=True):
-        model = room(A, B, conc=1 / n)
+        model = room_model(A, B, conc=1 / n)
         res = fit(model, [(obs, acts)], learn_A=False, iterations=200, init_counts=1.0, seed=0, **kw)
         bits = surprise_bits(model, held_obs, held_acts)
         where = place_of_states(model, obs, acts, places)

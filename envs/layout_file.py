@@ -32,13 +32,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import stat
 import struct
 from pathlib import Path
 
 import numpy as np
 from scipy import ndimage
+
+from cogmap.genmodel.files import regular_file_size
 
 from .geometry import Box, Cylinder
 from .layout_builder import WALL, WALL_H, Builder, Layout, wall_segments
@@ -128,19 +128,6 @@ class _Reader:
         if not isinstance(v, str) or not v.strip():
             self.fail(where, f"expected a non-empty string, got {json.dumps(v)}")
         return v
-
-
-def _regular_file(path: Path) -> int:
-    """Size of ``path``, refusing what is not a regular file (directory, device, fifo, ...)."""
-    try:
-        st = os.stat(path)
-    except OSError as err:
-        raise LayoutFileError(f"{path}: {err.strerror}") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise LayoutFileError(f"{path}: not a regular file")
-    if st.st_size > MAX_FILE_BYTES:
-        raise LayoutFileError(f"{path}: {st.st_size} bytes, above the limit of {MAX_FILE_BYTES} for a layout file")
-    return st.st_size
 
 
 def check_extent(bounds, source: str = "layout", where: str = "bounds") -> None:
@@ -371,7 +358,7 @@ def read_png_mask(path: Path) -> np.ndarray:
     import cv2
 
     path = Path(path)
-    _regular_file(path)
+    regular_file_size(path, LayoutFileError, MAX_FILE_BYTES, "MAX_FILE_BYTES")
     w, h = png_size(path)
     if w * h > MAX_IMAGE_PIXELS or w == 0 or h == 0:
         raise LayoutFileError(f"{path}: {w} x {h} pixels, outside 1 .. {MAX_IMAGE_PIXELS} pixels for a plan")
@@ -439,7 +426,7 @@ def load_layout(path, metres_per_pixel: float | None = None, check_space: bool =
         return layout_from_image(path, metres_per_pixel or DEFAULT_METRES_PER_PIXEL, check_space=check_space)
     if path.suffix.lower() != ".json":
         raise LayoutFileError(f"{path}: expected a .json building or a .png plan")
-    _regular_file(path)
+    regular_file_size(path, LayoutFileError, MAX_FILE_BYTES, "MAX_FILE_BYTES")
     try:
         d = json.loads(path.read_text())
     except UnicodeDecodeError:

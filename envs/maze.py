@@ -131,7 +131,7 @@ class Maze:
         Parameters
         ----------
         i, j : int
-            Cell indices along x and y.
+            The cell, as for :meth:`cell_centre`.
 
         Returns
         -------

@@ -123,7 +123,7 @@ class OccupancyGrid:
         Parameters
         ----------
         start_xy : array_like
-            ``(x, y)`` in metres.
+            As for :meth:`reachable`.
 
         Returns
         -------

@@ -262,7 +262,7 @@ class NavSim(FaultInjection):
         Returns
         -------
         MoveResult
-            Ground-truth outcome of the move.
+            As :meth:`move_to`.
 
         Raises
         ------

@@ -88,4 +88,62 @@ def aliased_room(side: int = 4, views: int = 6, noise: float = 0.06, seed: int =
     return A, B, label
 
 
+def room_model(A, B, conc=None) -> Model:
+    """The one-factor room model of ``(A, B)`` (uniform ``D``), or with ``conc`` given a learner of
+    ``B``: ``B`` uniform and prior counts ``conc`` on every entry.
+
+    Parameters
+    ----------
+    A : numpy.ndarray
+        ``(views, places)`` likelihood (e.g. from :func:`aliased_room`).
+    B : numpy.ndarray
+        ``(places, places, controls)`` transitions.
+    conc : float, optional
+        Prior count per entry of a learned ``B``; None keeps ``B`` as given.
+
+    Returns
+    -------
+    Model
+    """
+    n, U = B.shape[1], B.shape[2]
+    spec = ModelSpec([Factor("place", n, num_controls=U)], [Modality("view", A.shape[0], ("place",))],
+                     A={"view": A}, B={"place": B if conc is None else np.full((n, n, U), 1 / n)},
+                     D={"place": np.full(n, 1 / n)})
+    if conc is not None:
+        spec.pB["place"] = np.full((n, n, U), conc)
+    return compile(spec)
+
+
+def room_walk(A, B, steps: int, seed: int):
+    """A seeded random walk of ``steps`` observations in a room with deterministic moves ``B``.
+
+    Parameters
+    ----------
+    A, B : numpy.ndarray
+        As for :func:`room_model`.
+    steps : int
+        Observations (one more than actions).
+    seed : int
+        Seed of the start, the moves and the views.
+
+    Returns
+    -------
+    obs : list of list of int
+        One ``[view]`` per step.
+    acts : list of int
+        The ``steps - 1`` moves.
+    places : numpy.ndarray
+        ``(steps,)`` int true places.
+    """
+    rng = np.random.default_rng(seed)
+    s, obs, acts, places = int(rng.integers(B.shape[0])), [], [], []
+    for t in range(steps):
+        if t:
+            acts.append(int(rng.integers(B.shape[2])))
+            s = int(np.argmax(B[:, s, acts[-1]]))
+        places.append(s)
+        obs.append([int(rng.choice(A.shape[0], p=A[:, s]))])
+    return obs, acts, np.array(places)
+
+
 MODELS = {"tmaze": tmaze, "corridor": corridor, "random": random_model}

@@ -12,8 +12,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
-import stat
 import zipfile
 from dataclasses import asdict, replace
 from pathlib import Path
@@ -22,6 +20,7 @@ import numpy as np
 
 from .compile import MAX_ENTRIES, check_entries
 from .compile import compile as compile_spec
+from .files import regular_file_size
 from .model import Model
 from .spec import Factor, InductiveSpec, Modality, ModelSpec, PoseSpec, SparseA, SparseB, SpecError
 from .transitions import SparseTransitions
@@ -130,21 +129,6 @@ def save(model: Model, path) -> tuple[Path, Path]:
     return npz_path, json_path
 
 
-def _regular_file(p: Path) -> int:
-    """Size of ``p``; refuses anything but an existing regular file (symlinks are followed, so a
-    link to a directory or a device is refused too)."""
-    try:
-        st = os.stat(p)
-    except FileNotFoundError:
-        raise ModelFileError(f"{p}: file not found") from None
-    except OSError as err:
-        raise ModelFileError(f"{p}: cannot be read ({err.strerror})") from None
-    if not stat.S_ISREG(st.st_mode):
-        kind = "a directory" if stat.S_ISDIR(st.st_mode) else "a device, pipe or socket"
-        raise ModelFileError(f"{p}: not a regular file ({kind})")
-    return st.st_size
-
-
 def _read_headers(npz_path: Path, max_entries: int) -> None:
     """Check every array's declared shape and type in the archive before decompressing any."""
     try:
@@ -173,7 +157,7 @@ def load(path, max_entries: int = MAX_ENTRIES) -> Model:
     ``max_entries`` bounds every array (in the file and at the declared capacities) before it
     is allocated, as in :func:`~cogmap.genmodel.compile.compile`."""
     npz_path, json_path = _paths(path)
-    sizes = {p: _regular_file(p) for p in (npz_path, json_path)}
+    sizes = {p: regular_file_size(p, ModelFileError) for p in (npz_path, json_path)}
     if sizes[json_path] > MAX_JSON_BYTES:
         raise ModelFileError(f"{json_path}: {sizes[json_path]} bytes, too large for a model description")
     try:

@@ -51,19 +51,11 @@ def _array_name(path) -> str:
 
 def _read_config(json_path: Path) -> DVBFConfig:
     """The configuration in ``model.json``, every field checked (:class:`DVBFConfig` bounds the sizes)."""
-    import os
-    import stat
     from dataclasses import fields
 
-    try:
-        st = os.stat(json_path)
-    except OSError as err:
-        raise DVBFModelError(f"{json_path}: {err.strerror}") from None
-    if not stat.S_ISREG(st.st_mode):
-        raise DVBFModelError(f"{json_path}: not a regular file")
-    if st.st_size > MAX_MODEL_JSON_BYTES:
-        raise DVBFModelError(f"{json_path}: {st.st_size} bytes, above the limit of {MAX_MODEL_JSON_BYTES} "
-                             f"(MAX_MODEL_JSON_BYTES)")
+    from cogmap.genmodel.files import regular_file_size
+
+    regular_file_size(json_path, DVBFModelError, MAX_MODEL_JSON_BYTES, "MAX_MODEL_JSON_BYTES")
     try:
         meta = json.loads(json_path.read_text())
     except (UnicodeDecodeError, json.JSONDecodeError) as err:

@@ -26,6 +26,20 @@ def heading_index(dx: float, dy: float) -> int:
     return int(np.argmin(diff))
 
 
+def lattice(cells, allowed=None) -> nx.Graph:
+    """The 8-connected graph of lattice ``cells`` (node ``i`` is ``cells[i]``), without the edges
+    ``allowed(x, y, dx, dy)`` refuses."""
+    index = {c: i for i, c in enumerate(cells)}
+    G = nx.Graph()
+    G.add_nodes_from(range(len(cells)))
+    for (x, y), i in index.items():
+        for dx, dy in ((1, 0), (0, 1), (1, 1), (1, -1)):
+            j = index.get((x + dx, y + dy))
+            if j is not None and (allowed is None or allowed(x, y, dx, dy)):
+                G.add_edge(i, j)
+    return G
+
+
 def lattice_graph(n: int, rng: np.random.Generator, drop: float = 0.1) -> tuple[nx.Graph, np.ndarray]:
     """About ``n`` nodes on a 1 m lattice, 8-connected, with ``drop`` of the cells removed
     (obstacles); relabelled 0..n-1 by position, poses returned as an (n, 2) array."""
@@ -34,16 +48,7 @@ def lattice_graph(n: int, rng: np.random.Generator, drop: float = 0.1) -> tuple[
     keep = rng.permutation(len(cells))[:n]
     keep.sort()
     cells = [cells[i] for i in keep]
-    index = {c: i for i, c in enumerate(cells)}
-    G = nx.Graph()
-    G.add_nodes_from(range(len(cells)))
-    for (x, y), i in index.items():
-        for dx, dy in ((1, 0), (0, 1), (1, 1), (1, -1)):
-            j = index.get((x + dx, y + dy))
-            if j is not None:
-                G.add_edge(i, j)
-    poses = np.asarray(cells, dtype=float)
-    return G, poses
+    return lattice(cells), np.asarray(cells, dtype=float)
 
 
 def graph_arrays(

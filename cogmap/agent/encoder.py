@@ -401,7 +401,7 @@ class SSIMEncoder:
         Parameters
         ----------
         image : numpy.ndarray
-            ``(H, W)`` grey or ``(H, W, C)`` RGB query.
+            The query, as for :meth:`candidates`.
 
         Returns
         -------

@@ -158,8 +158,8 @@ class FrontierPaperExplorer(FrontierExplorer):
 
         Parameters
         ----------
-        odom : numpy.ndarray or None
-            ``(3,)`` odometry pose.
+        odom
+            As in :meth:`FrontierExplorer.decide`.
 
         Returns
         -------

@@ -142,14 +142,14 @@ class NextBestView(FrontierExplorer):
 
         Parameters
         ----------
-        odom : numpy.ndarray or None
-            ``(3,)`` odometry pose.
+        odom
+            As in :meth:`FrontierExplorer.decide`.
 
         Returns
         -------
         numpy.ndarray or None
-            ``(2,)`` float waypoint in the odometry frame, metres (the current position while no
-            map exists yet); None when there is no odometry or nothing is left worth a detour.
+            The waypoint as in :meth:`FrontierExplorer.decide`; None also when nothing is left
+            worth a detour.
         """
         cfg = self.cfg
         if odom is None or self.map is None or self.map.bbox is None:

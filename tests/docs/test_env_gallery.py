@@ -1,27 +1,16 @@
 """docs/environments.md shows every registered id, with the spaces its environment declares today
 and a picture; a new id, a changed space or a missing picture makes it stale."""
 
-import importlib.util
-from pathlib import Path
-
 import cv2
 import gymnasium as gym
 import pytest
+from docs_scripts import docs_script
 
 pytest.importorskip("pybullet")
 
-DOCS = Path(__file__).resolve().parents[2] / "docs"
-
-
-def _module():
-    spec = importlib.util.spec_from_file_location("envs_gallery", DOCS / "envs_gallery.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
 
 def test_the_gallery_page_is_what_the_registered_environments_declare():
-    mod = _module()
+    mod = docs_script("envs_gallery")
     ids = mod.registered_ids()
     assert len(ids) == 12 and all(i in gym.registry for i in ids)
     described = [mod.describe(i) for i in ids]

@@ -6,7 +6,7 @@ import networkx as nx
 import numpy as np
 
 from cogmap.planning.arrays import PlanningArrays
-from cogmap.planning.testing import graph_arrays
+from cogmap.planning.testing import graph_arrays, lattice
 
 
 def _norm(x, axis=0):
@@ -54,19 +54,11 @@ def corridor_rooms():
     for x in range(6, 9):
         for y in range(3):
             cells.append((x, y))  # room 2
+    def allowed(x, y, dx, dy):  # the corridor is one cell wide: no diagonal entries
+        return not ((3 <= x <= 5 or 3 <= x + dx <= 5) and dy != 0)
+
     index = {c: i for i, c in enumerate(cells)}
-    G = nx.Graph()
-    G.add_nodes_from(range(len(cells)))
-    for (x, y), i in index.items():
-        for dx, dy in ((1, 0), (0, 1), (1, 1), (1, -1)):
-            j = index.get((x + dx, y + dy))
-            if j is None:
-                continue
-            in_corr = 3 <= x <= 5 or 3 <= x + dx <= 5
-            if in_corr and dy != 0:  # the corridor is one cell wide: no diagonal entries
-                continue
-            G.add_edge(i, j)
-    return G, np.asarray(cells, dtype=float), index
+    return lattice(cells, allowed), np.asarray(cells, dtype=float), index
 
 
 def chain(n=12):
