@@ -7,13 +7,39 @@ from pathlib import Path
 import numpy as np
 
 
-def _plt():
+def pyplot():
+    """``matplotlib.pyplot`` on the Agg backend (figures written to files, no display needed).
+
+    Returns
+    -------
+    module
+        ``matplotlib.pyplot``.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     return plt
+
+
+def save_figure(fig, path: Path, dpi: int = 110) -> None:
+    """Lay out ``fig``, write it as a PNG to ``path`` and close it.
+
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    path : pathlib.Path
+        PNG file to write.
+    dpi : int, optional
+        Resolution, default 110.
+    """
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
 
 
 def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> Path:
@@ -42,7 +68,7 @@ def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> 
     from cogmap.envs.render import draw_layout
     from cogmap.genmodel.graph import to_graph
 
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 8))
     draw_layout(sim.layout, path=np.asarray(sim.path), ax=ax, show_starts=False)
     if agent.model is not None:
@@ -60,9 +86,7 @@ def map_over_floorplan(path: Path, sim, agent, ep, title: str | None = None) -> 
     cov = ep.coverage[-1] if ep.coverage else 0.0
     ax.set_title(title or f"{sim.layout.name}: {agent.num_states} states, coverage {cov:.0%}, "
                  f"{ep.distance[-1] if ep.distance else 0:.0f} m travelled")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
     return Path(path)
 
 
@@ -83,7 +107,7 @@ def coverage_curve(path: Path, ep, label: str = "AIMAPP") -> Path:
     pathlib.Path
         ``path``.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 4))
     ax.plot(ep.distance, np.asarray(ep.coverage) * 100, lw=2, label=label)
     ax.set_xlabel("distance travelled (m)")
@@ -91,7 +115,5 @@ def coverage_curve(path: Path, ep, label: str = "AIMAPP") -> Path:
     ax.set_ylim(0, 101)
     ax.grid(alpha=0.3)
     ax.legend(loc="lower right")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path, dpi=110)
     return Path(path)

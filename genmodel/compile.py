@@ -57,6 +57,18 @@ def _check_name(name: str, known: dict, kind: str, where: str) -> None:
         raise SpecError(f"{where}: unknown {kind} '{name}' (known: {sorted(known)})")
 
 
+def _named(item, cls, kind: str, seen: dict) -> None:
+    """Refuse a factor or modality that is not a ``cls``, is unnamed or named twice, or whose size is not a count."""
+    if not isinstance(item, cls):
+        raise SpecError(f"{'factors' if kind == 'factor' else 'modalities'} must be {cls.__name__} instances, "
+                        f"got {type(item).__name__}")
+    if not isinstance(item.name, str) or not item.name:
+        raise SpecError(f"{kind} {item.name!r}: the name must be a non-empty string")
+    if item.name in seen:
+        raise SpecError(f"{kind} '{item.name}': declared twice")
+    _count(item.size, f"{kind} '{item.name}' size")
+
+
 def _count(value, what: str, minimum: int = 1) -> int:
     """An integer size or count (an int, not a bool, float or string) of at least ``minimum``."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, int | np.integer):
@@ -101,13 +113,7 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
             raise SpecError(f"{table}: expected a dict keyed by name, got {type(getattr(spec, table)).__name__}")
     factors: dict[str, Factor] = {}
     for f in spec.factors:
-        if not isinstance(f, Factor):
-            raise SpecError(f"factors must be Factor instances, got {type(f).__name__}")
-        if not isinstance(f.name, str) or not f.name:
-            raise SpecError(f"factor {f.name!r}: the name must be a non-empty string")
-        if f.name in factors:
-            raise SpecError(f"factor '{f.name}': declared twice")
-        _count(f.size, f"factor '{f.name}' size")
+        _named(f, Factor, "factor", factors)
         _count(f.num_controls, f"factor '{f.name}' num_controls")
         if f.stay is not None:
             _count(f.stay, f"factor '{f.name}' stay", minimum=0)
@@ -116,13 +122,7 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
         factors[f.name] = f
     modalities: dict[str, Modality] = {}
     for m in spec.modalities:
-        if not isinstance(m, Modality):
-            raise SpecError(f"modalities must be Modality instances, got {type(m).__name__}")
-        if not isinstance(m.name, str) or not m.name:
-            raise SpecError(f"modality {m.name!r}: the name must be a non-empty string")
-        if m.name in modalities:
-            raise SpecError(f"modality '{m.name}': declared twice")
-        _count(m.size, f"modality '{m.name}' size")
+        _named(m, Modality, "modality", modalities)
         if isinstance(m.depends_on, str) or not isinstance(m.depends_on, tuple | list):
             raise SpecError(f"modality '{m.name}': depends_on must be a tuple of factor names, got {m.depends_on!r}")
         if not m.depends_on:

@@ -74,8 +74,7 @@ def fpi(model, prior, observations, actions=None, *, num_iter: int = 16, tol: fl
     Parameters
     ----------
     model, prior, observations, actions
-        The arguments every scheme takes (:class:`cogmap.genmodel.contracts.InferenceScheme`), checked
-        and documented by :func:`cogmap.inference.base.prepare`.
+        As for :func:`cogmap.inference.exact.exact`.
     num_iter : int, optional
         Sweeps per step, an integer >= 1 (pymdp's default 16).
     tol : float, optional

@@ -135,7 +135,7 @@ class OdomMap:
         Parameters
         ----------
         rc : array_like
-            ``(..., 2)`` ``(row, col)``.
+            ``(..., 2)`` cells, as :meth:`cogmap.envs.occupancy.OccupancyGrid.cell_to_world` takes them.
 
         Returns
         -------

@@ -124,7 +124,7 @@ HEADER = ["method", "episodes", "success %", "collision-free success %", "stuck 
 
 
 def drone_report(study_dir: Path, plan, results) -> str:
-    from .tables import md_table, pyplot, write_csv
+    from .tables import md_table, pyplot, save_figure, write_csv
 
     study_dir = Path(study_dir)
     out = []
@@ -186,9 +186,7 @@ def drone_report(study_dir: Path, plan, results) -> str:
             ax.axhline(PAPER["success"], c="tab:blue", ls="--", lw=0.8)
             ax.axhline(PAPER["collision_free_success"], c="tab:orange", ls="--", lw=0.8)
         ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(study_dir / "success.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, study_dir / "success.png", dpi=100)
     note = ("Success = final distance <= 1.5 m; stuck = the drone stayed within 1 m of where it was 15 s earlier; "
             "timeout = 250 simulated seconds or 250 steps; crashed = a collision with collisions ending the episode. "
             "Replans = in-flight replanning because an obstacle came within 2 m, mean over successful and failed "

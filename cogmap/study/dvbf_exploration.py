@@ -117,7 +117,7 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
     from cogmap.dvbf.explore import ratio_at
     from cogmap.envs.maze import TABLE_II
 
-    from .tables import md_table, pyplot, write_csv
+    from .tables import md_table, pyplot, save_figure, write_csv
 
     study_dir = Path(study_dir)
     rows, csv_rows, per_run = [], [], []
@@ -199,9 +199,7 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
         ax.set_ylim(0, 1.02)
         ax.set_ylabel("exploration ratio")
         ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(study_dir / "ratio.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, study_dir / "ratio.png", dpi=100)
     note = ("Exploration ratio: fraction of the Table II tiles visited by the true positions at the budget. "
             "Information gain: KL(q(M) || p(M)) of the agent's map at the end (paper Appendix D); the baselines "
             "learn no map in this study. Planning call: one whole MI planning step (obstacle penalty from the "

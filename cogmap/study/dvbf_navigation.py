@@ -168,7 +168,7 @@ def run_navigation(spec: dict) -> dict:
 def nav_report(study_dir: Path, plan, results) -> str:
     from cogmap.dvbf.navigate import summarise
 
-    from .tables import md_table, pyplot, write_csv
+    from .tables import md_table, pyplot, save_figure, write_csv
 
     study_dir = Path(study_dir)
     rows = []
@@ -220,9 +220,7 @@ def nav_report(study_dir: Path, plan, results) -> str:
     ax.set_ylabel("share of pairs reached (within 0.05)")
     ax.set_ylim(0, 1.02)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(study_dir / "success.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, study_dir / "success.png", dpi=100)
     first = {r["spec"]["method"]: r["result"]["model"] for r in results[::-1]}
     model = first.get("hybrid_astar", first.get("pose_to_observation", {}))
     n_pairs = plan["params"]["pairs"]

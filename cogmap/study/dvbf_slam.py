@@ -168,7 +168,7 @@ def _at(curve, every, step):
 
 
 def dvbf_slam_report(study_dir: Path, plan, results) -> str:
-    from .tables import md_table, pyplot, write_csv
+    from .tables import md_table, pyplot, save_figure, write_csv
 
     study_dir = Path(study_dir)
     results = sorted(results, key=lambda r: (METHODS.index(r["spec"]["method"]), _maze_seed(r["spec"]["env"]),
@@ -223,9 +223,7 @@ def dvbf_slam_report(study_dir: Path, plan, results) -> str:
     ax.set_xlabel("step")
     ax.set_ylabel("localisation error (maze units)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(study_dir / "error.png", dpi=100)
-    plt.close(fig)
+    save_figure(fig, study_dir / "error.png", dpi=100)
     noise = results[0]["spec"]["noise"]
     parts = ["Each cell: the method / path integration, localisation error (distance of the particle mean to the "
              "true position) in units of the maze side (1); all methods filter the same seeded traversals "

@@ -8,7 +8,7 @@ import numpy as np
 
 from . import paper
 from .metrics_extra import duplicates, fraction_within, summarise
-from .tables import md_table, pyplot, write_csv
+from .tables import md_table, pyplot, save_figure, write_csv
 
 METHOD_LABEL = {"aimapp": "AIMAPP", "aimapp_revisits": "AIMAPP (revisits only)",
                 "frontier": "Frontiers (nearest reachable cell)",
@@ -214,9 +214,7 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
         ax.set_ylim(0, 1.02)
     axes[0][0].set_ylabel("LiDAR coverage")
     axes[0][0].legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
-    fig.savefig(study_dir / "coverage_curves.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, study_dir / "coverage_curves.png", dpi=110)
 
     fig, ax = plt.subplots(figsize=(2.6 + 1.6 * len(envs), 4.2))
     w = 0.8 / max(1, len(plan["methods"]))
@@ -233,9 +231,7 @@ def _exploration_figures(study_dir: Path, plan, groups) -> None:
     ax.set_xticklabels(envs, fontsize=8, rotation=60 if len(envs) > 8 else 0, ha="right" if len(envs) > 8 else "center")
     ax.set_ylabel(f"CE at {level:.0%} coverage (m²/m)\nsuccessful runs")
     ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2, frameon=False)
-    fig.tight_layout()
-    fig.savefig(study_dir / "coverage_efficiency.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, study_dir / "coverage_efficiency.png", dpi=110)
 
 
 # ---------------------------------------------------------------------------- generalisation
@@ -414,9 +410,7 @@ def _goal_figure(study_dir, reached) -> None:
     r = [g["plr_executed_vs_astar"] for g in reached if g["plr_executed_vs_astar"] is not None]
     axes[1].hist(r, bins=15)
     axes[1].set_xlabel("PLR executed / A*")
-    fig.tight_layout()
-    fig.savefig(study_dir / "goal_plr.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, study_dir / "goal_plr.png", dpi=110)
 
 
 # ---------------------------------------------------------------------------- drift
@@ -526,9 +520,7 @@ def obstacle_report(study_dir: Path, plan, results) -> str:
     ax.set_xlabel("steps since the box moved")
     ax.set_ylabel("P(transition into blocked node)")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(study_dir / "obstacle_transitions.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, study_dir / "obstacle_transitions.png", dpi=110)
     write_csv(study_dir / "table.csv", header, rows)
     note = ("Figure 8 protocol: after exploring, the movable box is scheduled onto a free node the agent knows; "
             "we track the believed probabilities of the transitions from other states into that node "
@@ -557,9 +549,7 @@ def scaling_report(study_dir: Path, plan, results) -> str:
     axes[0].legend(fontsize=7)
     axes[1].set_xlabel("stored observations")
     axes[1].set_ylabel("model size (kB, npz + json)")
-    fig.tight_layout()
-    fig.savefig(study_dir / "scaling.png", dpi=110)
-    plt.close(fig)
+    save_figure(fig, study_dir / "scaling.png", dpi=110)
     states, ms = np.asarray(states), np.asarray(ms)
     header = ["states", "decisions", "mean ms", "p95 ms"]
     rows = []

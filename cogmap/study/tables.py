@@ -1,9 +1,14 @@
-"""Writers every study report shares: a markdown table, a CSV file, and pyplot without a display."""
+"""Writers every study report shares: a markdown table, a CSV file, and (from :mod:`cogmap.plots`)
+pyplot without a display and the figure writer."""
 
 from __future__ import annotations
 
 import csv
 from pathlib import Path
+
+from cogmap.plots import pyplot, save_figure
+
+__all__ = ["md_table", "pyplot", "save_figure", "write_csv"]
 
 
 def md_table(header, rows) -> str:
@@ -19,13 +24,3 @@ def write_csv(path: Path, header, rows) -> None:
         w = csv.writer(fh)
         w.writerow(header)
         w.writerows(rows)
-
-
-def pyplot():
-    """``matplotlib.pyplot`` on the Agg backend (figures written to files, no display needed)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
