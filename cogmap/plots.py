@@ -24,7 +24,7 @@ def pyplot():
 
 
 def save_figure(fig, path: Path, dpi: int = 110) -> None:
-    """Lay out ``fig``, write it as a PNG to ``path`` and close it.
+    """Lay out ``fig``, write it as a PNG to ``path`` (its folder created if missing) and close it.
 
     Parameters
     ----------
@@ -38,6 +38,7 @@ def save_figure(fig, path: Path, dpi: int = 110) -> None:
     import matplotlib.pyplot as plt
 
     fig.tight_layout()
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
 

@@ -19,6 +19,7 @@ from cogmap.agent.encoder import available_encoders  # noqa: E402
 from cogmap.envs.layouts import LAYOUTS  # noqa: E402
 from cogmap.planning import efe  # noqa: E402
 from cogmap.planning.planners import available_planners  # noqa: E402
+from cogmap.plots import save_figure
 from cogmap.study import studies  # noqa: E402
 
 OUT = Path(__file__).resolve().parent / "img" / "architecture.png"
@@ -102,9 +103,7 @@ def main() -> None:
     right.text(1.6, 1.75, "next reading", ha="center", va="bottom", fontsize=7.4, style="italic", color="#333")
     right.text(5.0, 0.15, "agent: state = init(model, config, key); state, info = step(state, observation)",
                ha="center", fontsize=8.2, family="monospace")
-    fig.tight_layout()
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(OUT, dpi=110)
+    save_figure(fig, OUT, dpi=110)
     print(f"wrote {OUT}")
 
 

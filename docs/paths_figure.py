@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from cogmap.plots import save_figure
+
 OUT = Path(__file__).resolve().parent / "img" / "exploration" / "paths-to-90.png"
 CASES = (("small_warehouse", 0), ("aisle_warehouse", 4))
 METHODS = (("aimapp", "AIMAPP"), ("nbv", "next-best view, own map"), ("oracle", "oracle, true map"))
@@ -48,9 +50,7 @@ def main() -> None:
                         title=f"{env} seed {seed}: {label}\n{dist:.1f} m to {COVERAGE_LEVEL:.0%} coverage")
             ax.plot(*xy[0], "*", ms=14, color="tab:green", zorder=9)
             ax.title.set_fontsize(10)
-    fig.tight_layout()
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(OUT, dpi=80)
+    save_figure(fig, OUT, dpi=80)
     print(f"wrote {OUT}")
 
 

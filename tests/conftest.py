@@ -21,3 +21,13 @@ os.environ.setdefault("JAX_PERSISTENT_CACHE_MIN_COMPILE_TIME_SECS", "0.1")  # an
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     heavy_files = {item.path for item in items if item.get_closest_marker("heavy") is not None}
     items.sort(key=lambda item: item.path not in heavy_files)  # stable: order within a file is kept
+
+
+@pytest.fixture
+def registered(request):
+    """The names a test registers (it appends them); each is removed after the test with its
+    module's ``UNREGISTER`` function."""
+    names = []
+    yield names
+    for name in names:
+        request.module.UNREGISTER(name)

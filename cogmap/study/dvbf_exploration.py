@@ -32,6 +32,14 @@ REDUCED_LEVELS = ("simple-small", "moderate-small", "complex-small")
 REDUCED_STEPS = 200
 
 
+# what the report's columns measure (its note begins with this)
+MEASURES = ("Exploration ratio: fraction of the Table II tiles visited by the true positions at the budget. "
+            "Information gain: KL(q(M) || p(M)) of the agent's map at the end (paper Appendix D); the baselines "
+            "learn no map in this study. Planning call: one whole MI planning step (obstacle penalty from the "
+            "learnt map, candidate optimisation, MI of every candidate), wall clock on this shared 2-core machine. "
+            "MI settings of the study (not the paper's, which are about 100 times heavier):")
+
+
 def level_of(env: str) -> tuple[str, str]:
     """``"moderate-small"`` -> ``("moderate", "small")``, with a clear error for an unknown row."""
     if env not in ALL_LEVELS:
@@ -200,12 +208,7 @@ def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
         ax.set_ylabel("exploration ratio")
         ax.legend(fontsize=7)
     save_figure(fig, study_dir / "ratio.png", dpi=100)
-    note = ("Exploration ratio: fraction of the Table II tiles visited by the true positions at the budget. "
-            "Information gain: KL(q(M) || p(M)) of the agent's map at the end (paper Appendix D); the baselines "
-            "learn no map in this study. Planning call: one whole MI planning step (obstacle penalty from the "
-            "learnt map, candidate optimisation, MI of every candidate), wall clock on this shared 2-core machine. "
-            "MI settings of the study (not the paper's, which are about 100 times heavier): "
-            f"{asdict_short(plan)}. Mean ± std over seeds; the shaded band in ratio.png is one std.")
+    note = f"{MEASURES} {asdict_short(plan)}. Mean ± std over seeds; the shaded band in ratio.png is one std."
     if "mi-pull" in plan["methods"]:
         from cogmap.dvbf.explore import PULL_BELOW
         from cogmap.planning.mi_exploration import MIConfig

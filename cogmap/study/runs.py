@@ -63,6 +63,21 @@ def study_sim(env: str, cfg, seed: int, noise=None):
     return make_sim(env, cfg, seed, noise)
 
 
+def study_agent(spec):
+    """The AIMAPP agent of a room spec (its room's default config and seed) and its
+    :func:`study_sim`; the caller closes the simulator."""
+    from cogmap.agent.aimapp import AIMAPPAgent
+    from cogmap.explore import default_config
+
+    cfg = default_config(spec["env"])
+    sim = study_sim(spec["env"], cfg, spec["seed"])
+    try:
+        return AIMAPPAgent(cfg, seed=spec["seed"]), sim
+    except BaseException:
+        sim.close()
+        raise
+
+
 def _curve(ep, points: int = 120) -> dict:
     d, c = np.asarray(ep.distance), np.asarray(ep.coverage)
     idx = np.unique(np.linspace(0, len(d) - 1, min(points, len(d))).round().astype(int))
@@ -285,14 +300,11 @@ def run_goals(spec) -> dict:
 def run_obstacle(spec) -> dict:
     """Figure 8: explore, move a box onto a free node the agent knows, track the belief of
     transitions into that node."""
-    from cogmap.agent.aimapp import AIMAPPAgent
-    from cogmap.explore import default_config, run_agent
+    from cogmap.explore import run_agent
 
     p = spec["params"]
-    cfg = default_config(spec["env"])
-    sim = study_sim(spec["env"], cfg, spec["seed"])
+    agent, sim = study_agent(spec)
     try:
-        agent = AIMAPPAgent(cfg, seed=spec["seed"])
         trace = []
 
         def record(phase):
@@ -361,14 +373,11 @@ def model_size_bytes(model) -> int:
 def run_scaling(spec) -> dict:
     """Figure 13: time per decision against the number of states; model size against the
     number of stored observations."""
-    from cogmap.agent.aimapp import AIMAPPAgent
-    from cogmap.explore import default_config, run_agent
+    from cogmap.explore import run_agent
 
     every = spec["params"]["size_every"]
-    cfg = default_config(spec["env"])
-    sim = study_sim(spec["env"], cfg, spec["seed"])
+    agent, sim = study_agent(spec)
     try:
-        agent = AIMAPPAgent(cfg, seed=spec["seed"])
         sizes = []
 
         def on_step(_d):

@@ -15,13 +15,7 @@ from cogmap.agent.encoder import (
 )
 from cogmap.agent.testing import BoxWorld, CellEncoder, run
 
-
-@pytest.fixture
-def registered():
-    names = []
-    yield names
-    for n in names:
-        unregister_encoder(n)
+UNREGISTER = unregister_encoder  # what the suite's ``registered`` fixture removes with
 
 
 def test_register_encoder_errors(registered):

@@ -22,12 +22,7 @@ def closet(seed: int = 0) -> Layout:
     return Layout("closet", (-0.1, -0.1, 3.1, 3.1), (*walls, pillar), ((0.8, 0.8, 0.0),))
 
 
-@pytest.fixture
-def registered():
-    names = []
-    yield names
-    for n in names:
-        unregister_layout(n)
+UNREGISTER = unregister_layout  # what the suite's ``registered`` fixture removes with
 
 
 def test_register_layout_errors(registered):

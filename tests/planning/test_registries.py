@@ -33,12 +33,7 @@ def term_name():
         unregister_term(n)
 
 
-@pytest.fixture
-def planner_name():
-    names = []
-    yield names
-    for n in names:
-        unregister_planner(n)
+UNREGISTER = unregister_planner  # what the suite's ``registered`` fixture removes with
 
 
 def _certain(model, s: int) -> list[np.ndarray]:
@@ -134,7 +129,7 @@ def test_epistemic_flag_decides_what_split_counts_once(term_name):
 
 
 # -- planners ---------------------------------------------------------------------------------
-def test_register_planner_errors(planner_name):
+def test_register_planner_errors(registered):
     def west(model, qs, objective, settings):
         return Plan((2,), np.zeros(1))
 
@@ -145,7 +140,7 @@ def test_register_planner_errors(planner_name):
     with pytest.raises(ValueError, match="built-in planner"):
         register_planner("mcts", west)
     register_planner("west", west)
-    planner_name.append("west")
+    registered.append("west")
     with pytest.raises(ValueError, match="exists.*overwrite=True"):
         register_planner("west", lambda *a: None)
     assert get_planner("west") is west
@@ -160,7 +155,7 @@ def test_register_planner_errors(planner_name):
     assert set(available_planners()) >= {"enumerate", "mcts", "west"}
 
 
-def test_the_loop_runs_a_registered_planner_with_its_settings(planner_name):
+def test_the_loop_runs_a_registered_planner_with_its_settings(registered):
     calls = []
 
     @register_planner("always_west")
@@ -168,7 +163,7 @@ def test_the_loop_runs_a_registered_planner_with_its_settings(planner_name):
         calls.append((len(qs), settings.policy_len, settings.gamma, settings.rng is not None))
         return Plan((2,), np.array([0.5]))
 
-    planner_name.append("always_west")
+    registered.append("always_west")
     state = loop.init(corridor(), planner="always_west", policy_len=3, gamma=4.0)
     state, info = loop.step(state, [0])
     assert info.action == (2,) and info.q_pi is None and info.G.tolist() == [0.5]
@@ -177,7 +172,7 @@ def test_the_loop_runs_a_registered_planner_with_its_settings(planner_name):
     np.testing.assert_allclose(state.prior[0], state.model.predict(0, info.qs[0], 2))
 
     register_planner("two_controls", lambda m, qs, o, s: Plan((1, 1), np.zeros(1)))
-    planner_name.append("two_controls")
+    registered.append("two_controls")
     with pytest.raises(ValueError, match="returned 2 control"):
         loop.step(loop.init(corridor(), planner="two_controls"), [0])
 
