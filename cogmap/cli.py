@@ -241,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("--quiet", action="store_true", help="no progress bar (it shows on runs longer than a second)")
     c.set_defaults(func=_compare)
 
-    from .drone.episode import METHODS as DRONE_METHODS
+    from .drone.methods import METHODS as DRONE_METHODS
 
     d = sub.add_parser("drone", help="the hierarchical active-inference drone in a 3D pybullet obstacle field")
     dsub = d.add_subparsers(dest="drone_command", required=True)

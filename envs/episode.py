@@ -10,7 +10,7 @@ the rooms, the drone field and the LiDAR mazes is split between two objects:
   is carried out.
 
 The rooms' episode is :class:`cogmap.harness.RoomEpisode`, the drone's
-:class:`cogmap.drone.episode.DroneEpisode` and the mazes' :class:`cogmap.dvbf.explore.MazeEpisode`.
+:class:`cogmap.envs.drone_episode.DroneEpisode` and the mazes' :class:`cogmap.envs.maze_episode.MazeEpisode`.
 """
 
 from __future__ import annotations

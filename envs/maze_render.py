@@ -117,3 +117,74 @@ def save_plans_png(maze: Maze, paths: dict, filename, radius: float, n: int = 4)
         fig.savefig(filename, dpi=110)
     finally:
         plt.close(fig)
+
+
+def save_error_png(err, err_pi, filename, label: str = "online") -> None:
+    """The localisation error of a SLAM run and of path integration over the steps, as a PNG.
+
+    Parameters
+    ----------
+    err, err_pi : numpy.ndarray
+        ``(T,)`` errors of the SLAM estimate and of path integration, maze units.
+    filename : path
+        PNG to write.
+    label : str, optional
+        ``"online"`` or ``"offline"`` (the SLAM's legend entry).
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6, 3.5))
+    try:
+        ax.plot(err, label=f"DVBF-LM {label} SLAM", c="tab:blue")
+        ax.plot(err_pi, label="path integration", c="tab:red")
+        ax.set_xlabel("step")
+        ax.set_ylabel("localisation error (maze side = 1)")
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(filename, dpi=110)
+    finally:
+        plt.close(fig)
+
+
+def save_ratio_png(results, maze: Maze, filename) -> None:
+    """Exploration ratio (and, where recorded, information gain) over the steps of each method, as a PNG.
+
+    Parameters
+    ----------
+    results : dict
+        Method name -> :class:`~cogmap.envs.maze_episode.ExploreResult`.
+    maze : Maze
+        The maze explored (its tile count labels the axis).
+    filename : path
+        PNG to write.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    has_info = any(r.info_curve for r in results.values())
+    fig, axes = plt.subplots(1, 2 if has_info else 1, figsize=(10 if has_info else 5.5, 3.6), squeeze=False)
+    colours = {"mi": "tab:blue", "random": "tab:red", "frontier": "tab:green"}
+    try:
+        for m, r in results.items():
+            c = np.array(r.ratio_curve)
+            axes[0, 0].plot(c[:, 0], c[:, 1], c=colours.get(m, "k"), label=m)
+            if has_info and r.info_curve:
+                i = np.array(r.info_curve)
+                axes[0, 1].plot(i[:, 0], i[:, 1], c=colours.get(m, "k"), label=m)
+        axes[0, 0].set_xlabel("step")
+        axes[0, 0].set_ylabel(f"exploration ratio ({maze.tiles} x {maze.tiles} tiles)")
+        axes[0, 0].set_ylim(0, 1.02)
+        axes[0, 0].legend()
+        if has_info:
+            axes[0, 1].set_xlabel("step")
+            axes[0, 1].set_ylabel("information gain KL(q(M) || p(M)) (nats)")
+            axes[0, 1].legend()
+        fig.tight_layout()
+        fig.savefig(filename, dpi=110)
+    finally:
+        plt.close(fig)

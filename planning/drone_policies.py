@@ -22,7 +22,7 @@ class Decision:
 
 
 class DronePolicy:
-    """What a drone episode (:func:`cogmap.drone.episode.fly_episode`) calls on a drone policy:
+    """What a drone episode (:func:`cogmap.envs.drone_episode.fly_episode`) calls on a drone policy:
     ``reset``, ``observe`` (every LiDAR scan, also those taken in flight), ``observe_contact``,
     ``decide``. By default a policy perceives LiDAR returns only and keeps them in its voxel map
     when it has one (``voxels``); ``decide`` is each policy's own.

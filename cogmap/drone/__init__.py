@@ -8,7 +8,9 @@ belief update as the ``"kernel"`` inference scheme, waypoint generation, filteri
 ``cogmap.envs`` (:mod:`~cogmap.envs.drone_sim`).
 """
 
+from cogmap.envs.drone_episode import EpisodeLimits, fly_episode, summarise
+
 from .agent import DroneAgent, DroneAgentConfig
-from .episode import EpisodeLimits, fly_episode, make_policy, summarise
+from .methods import make_policy
 
 __all__ = ["DroneAgent", "DroneAgentConfig", "EpisodeLimits", "fly_episode", "make_policy", "summarise"]

@@ -15,7 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .episode import EpisodeLimits, fly_episode, make_policy, summarise
+from cogmap.envs.drone_episode import EpisodeLimits, fly_episode, summarise
+
+from .methods import make_policy
 
 
 def episode_target(sim, seed: int, episode: int) -> np.ndarray:

@@ -56,11 +56,10 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from cogmap.envs.maze import Maze, exploration_ratio
+from cogmap.envs.maze import Maze
+from cogmap.envs.maze_episode import ExploreResult, MazeEpisode, MazePilot
 from cogmap.envs.maze_poses import start_pose
 from cogmap.envs.maze_sim import MazeSim
-from cogmap.envs.maze_traversal import MazeRun
-from cogmap.genmodel.contracts import Episode, EpisodePolicy
 from cogmap.planning.maze_explorers import Frontier, RandomWalk
 from cogmap.planning.mi_exploration import MIConfig
 from cogmap.planning.mi_planner import MIPlanner
@@ -184,53 +183,6 @@ def method_config(method: str, **fields) -> ExploreConfig:
         return ExploreConfig(method=method, **fields)
     mi = dataclasses.replace(fields.pop("mi", STUDY_MI), pull_below=PULL_BELOW)
     return ExploreConfig(method="mi", mi=mi, **fields)
-
-
-@dataclass
-class ExploreResult:
-    """One exploration run (what :func:`explore` returns). Lengths are in maze units, angles in radians.
-
-    Attributes
-    ----------
-    poses : numpy.ndarray, shape (T, 3)
-        True poses (x, y, heading).
-    controls : numpy.ndarray, shape (T - 1, 2)
-        Commanded controls (turn, forward).
-    scans : numpy.ndarray, shape (T, n_beams)
-        LiDAR ranges per step.
-    estimates : numpy.ndarray, shape (T, 3), or None
-        The online SLAM's pose estimates (``mi`` or ``learn_map``), else None.
-    ratio_curve : list of (int, float)
-        ``(step, exploration ratio)`` over the Table II tiles.
-    info_curve : list of (int, float)
-        ``(step, KL(q(M) || p(M)))`` in nats (Appendix D); empty without a map.
-    plan_seconds : list of float
-        Wall-clock seconds of each planning call.
-    blocked : int
-        Steps on which a wall stopped the robot.
-    pulled : int
-        Planning calls that followed the frontier pull (``MIConfig.pull_below``).
-    params : DVBFParams or None
-        q(M) and emission at the end (``mi`` or ``learn_map``).
-    model : DVBFConfig or None
-        The model of ``params``.
-    seconds : float
-        Wall-clock seconds of the whole run.
-    """
-
-    poses: np.ndarray  # (T, 3) true poses
-    controls: np.ndarray  # (T - 1, 2) commanded
-    scans: np.ndarray  # (T, n_beams)
-    estimates: np.ndarray | None  # (T, 3) the agent's pose estimates (mi / learn_map)
-    ratio_curve: list  # [(step, exploration ratio)]
-    info_curve: list  # [(step, KL(q(M) || p(M)))]
-    plan_seconds: list  # wall clock of each planning call
-    blocked: int
-    pulled: int = 0
-    params: object = None  # DVBF params at the end (mi / learn_map)
-    model: object = None  # DVBFConfig
-    seconds: float = 0.0
-
 
 
 class MIAgent:
@@ -363,111 +315,6 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
     return emission
 
 
-class MazePilot(EpisodePolicy):
-    """A maze explorer (:class:`MIAgent`, :class:`~cogmap.planning.maze_explorers.RandomWalk` or
-    :class:`~cogmap.planning.maze_explorers.Frontier`) as :func:`cogmap.envs.episode.run` calls
-    it: it senses the pose, scan and bump of the last step and returns the next control.
-
-    Parameters
-    ----------
-    policy : object
-        Anything with ``act(pose, scan, blocked) -> control``.
-    """
-
-    label = "maze"
-
-    def __init__(self, policy):
-        self.policy = policy
-
-    def sense(self, sim, outcome):
-        return outcome
-
-    def step(self, sensed) -> np.ndarray:
-        pose, scan, blocked = sensed
-        return self.policy.act(pose, scan, bool(blocked))
-
-
-@dataclass
-class MazeCurves:
-    """The exploration curves of a maze run.
-
-    Attributes
-    ----------
-    tiles : set of tuple
-        The Table II tiles visited.
-    ratio : list of (int, float)
-        ``(step, exploration ratio)``.
-    info : list of (int, float)
-        ``(step, KL(q(M) || p(M)))`` in nats; empty without a map.
-    """
-
-    tiles: set
-    ratio: list
-    info: list
-
-
-class MazeEpisode(Episode):
-    """One maze exploration as :func:`cogmap.envs.episode.run` drives it: the run of
-    :class:`~cogmap.envs.maze_traversal.MazeRun`, the online SLAM (if any) advanced on each step
-    and the curves recorded.
-
-    Parameters
-    ----------
-    sim : MazeSim
-        The simulator, reset at ``start``.
-    maze : Maze
-        Its maze.
-    cfg : ExploreConfig
-        ``curve_every`` (how often the curves are sampled).
-    slam : OnlineSLAM or None
-        The online SLAM fed with every step, if any.
-    steps : int
-        Time steps of the run (the start counts as step 0).
-    start : tuple
-        ``(pose, scan)`` at the start.
-    progress : callable, optional
-        Called with the step index after each step.
-    """
-
-    def __init__(self, sim, maze: Maze, cfg: ExploreConfig, slam, steps: int, start, progress=None):
-        from cogmap.genmodel.latent_map import kl_map
-
-        self.sensors, self.maze, self.cfg, self.slam, self.steps, self.progress = sim, maze, cfg, slam, steps, progress
-        pose, scan = start
-        self.record = MazeRun(sim, pose, scan)
-        self.curves = MazeCurves({tuple(r) for r in maze.tile_index(pose)}, [(0, exploration_ratio(maze, pose))], [])
-        if slam is not None:
-            self.curves.info.append((0, float(kl_map(slam.params.q_map))))
-
-    def act(self, u):
-        from cogmap.genmodel.latent_map import kl_map
-
-        maze, cfg, slam, curves = self.maze, self.cfg, self.slam, self.curves
-        pose, scan, blocked = self.record.act(u)
-        t = len(self.record.poses) - 1
-        curves.tiles.add(tuple(maze.tile_index(pose)[0]))
-        if slam is not None:
-            # a bump sensor tells the agent that a wall stopped it: the filter then sees no translation
-            # (the distance moved before the wall is not known to it)
-            slam.advance(np.array([u[0], 0.0 if blocked else u[1]])[None], scan[None])
-        if t % cfg.curve_every == 0 or t == self.steps - 1:
-            curves.ratio.append((t, len(curves.tiles) / maze.tiles**2))
-            if slam is not None and slam.t == t and t % (10 * cfg.curve_every) == 0:
-                curves.info.append((t, float(kl_map(slam.params.q_map))))
-        if self.progress is not None:
-            self.progress(t)
-        return pose, scan, blocked
-
-    def end(self) -> None:
-        from cogmap.genmodel.latent_map import kl_map
-
-        if self.slam is not None:
-            self.slam.flush()
-            last = self.steps - 1
-            if self.curves.info[-1][0] != last:
-                self.curves.info.append((last, float(kl_map(self.slam.params.q_map))))
-
-
 def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=None) -> ExploreResult:
     """Run one exploration of ``steps`` time steps (the start pose counts as step 0).
 
@@ -521,7 +368,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         else:
             policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
                       else Frontier(maze, cfg, cfg.seed, sim.lidar_range))
-        episode = MazeEpisode(sim, maze, cfg, slam, steps, (pose, scan), progress)
+        episode = MazeEpisode(sim, maze, cfg.curve_every, slam, steps, (pose, scan), progress)
         run(episode, MazePilot(policy), steps - 1, outcome=(pose, scan, 0))
         tr, curves = episode.record.traversal(), episode.curves
         est = slam.estimates[:steps].copy() if slam is not None else None
@@ -531,25 +378,3 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
                              model=slam.config.model if slam else None, seconds=time.perf_counter() - tic)
     finally:
         sim.close()
-
-
-def ratio_at(curve, step: int) -> float:
-    """The exploration ratio of a ``[(step, ratio)]`` curve at ``step`` (the last point at or before it).
-
-    Parameters
-    ----------
-    curve : iterable of (int, float)
-        ``(step, ratio)`` pairs in increasing step order.
-    step : int
-        The step to read.
-
-    Returns
-    -------
-    float
-        The ratio, 0.0 if no point is at or before ``step``.
-    """
-    best = 0.0
-    for s, r in curve:
-        if s <= step:
-            best = r
-    return best

@@ -105,7 +105,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     """
     if pretrain_maze is not None and pretrain_maze == maze_seed:
         raise ValueError(f"slam_run: the emission is pretrained on maze {pretrain_maze}; evaluate on another maze")
-    from cogmap.envs.maze_render import save_maze_png
+    from cogmap.envs.maze_render import save_error_png, save_maze_png
     from cogmap.runs import write_manifest
 
     out = Path(out)
@@ -169,31 +169,12 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
         "final_negative_elbo": float(res.losses[-1]) if len(res.losses) else None,
     }
     (out / "metrics.json").write_text(json.dumps(metrics, indent=1))
-    _error_png(err, err_pi, out / "error.png", label)
+    save_error_png(err, err_pi, out / "error.png", label)
     save_maze_png(maze, out / "map.png", paths=[("true", tr.poses, "k"),
                                                 (f"DVBF-LM {label}", res.estimates, "tab:blue"),
                                                 ("path integration", pi, "tab:red")],
                   particles=res.particles, title=f"maze {maze_seed}: {label} SLAM, {steps} steps")
     return metrics
-
-
-def _error_png(err, err_pi, filename, label: str = "online") -> None:
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    try:
-        ax.plot(err, label=f"DVBF-LM {label} SLAM", c="tab:blue")
-        ax.plot(err_pi, label="path integration", c="tab:red")
-        ax.set_xlabel("step")
-        ax.set_ylabel("localisation error (maze side = 1)")
-        ax.legend()
-        fig.tight_layout()
-        fig.savefig(filename, dpi=110)
-    finally:
-        plt.close(fig)
 
 
 def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int = 0, complexity: str = "simple",
@@ -234,17 +215,19 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     -------
     dict
         The contents of ``metrics.json``: the maze, budget and tiles, each method's
-        :func:`summarise`, and ``ratio_at_budget`` (method -> exploration ratio at the last step).
+        :meth:`~cogmap.envs.maze_episode.ExploreResult.metrics`, and ``ratio_at_budget`` (method ->
+        exploration ratio at the last step).
 
     Raises
     ------
     ValueError
         If ``maze_seed == 0``, or from :class:`~cogmap.dvbf.explore.ExploreConfig` for bad settings.
     """
-    from cogmap.envs.maze_render import save_maze_png
+    from cogmap.envs.maze_episode import ratio_at
+    from cogmap.envs.maze_render import save_maze_png, save_ratio_png
     from cogmap.runs import write_manifest
 
-    from .explore import STUDY_MI, explore, method_config, pretrained_emission, ratio_at
+    from .explore import STUDY_MI, explore, method_config, pretrained_emission
     from .explore import cache_dir as cache_dir_default
 
     out = Path(out)
@@ -271,7 +254,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
         if bar is not None:
             bar.close()
         results[m] = res
-        metrics["methods"][m] = summarise(res, maze, steps)
+        metrics["methods"][m] = res.metrics(steps)
     agent = next((m for m in ("mi", "mi-pull") if m in results and results[m].params is not None), None)
     if agent is not None:  # the first DVBF-LM agent's map (the paper's, else the one with the pull)
         save_params(results[agent].params, results[agent].model, out)
@@ -290,73 +273,5 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     save_maze_png(maze, out / "path.png", paths=[(f"{m} ({metrics['ratio_at_budget'][m]:.2f})", r.poses,
                                                   colours.get(m, "k")) for m, r in results.items()],
                   title=f"maze {maze_seed} ({complexity}, {corridor}): {steps} steps")
-    _ratio_png(results, maze, out / "ratio.png")
+    save_ratio_png(results, maze, out / "ratio.png")
     return metrics
-
-
-def summarise(res, maze, steps: int) -> dict:
-    """Metrics of one :class:`~cogmap.dvbf.explore.ExploreResult`.
-
-    Parameters
-    ----------
-    res : ExploreResult
-        One method's exploration.
-    maze : Maze
-        The maze it explored (unused; kept for a uniform call).
-    steps : int
-        Time steps of the run; the final ratio is read at step ``steps - 1``.
-
-    Returns
-    -------
-    dict
-        ``ratio_final`` and ``ratio_curve`` (exploration ratio, Appendix D), ``info_gain_curve`` and
-        ``info_gain_final`` (``KL(q(M) || p(M))`` in nats, None without a map), ``blocked_steps``, ``pulled_plans``,
-        ``path_length`` (maze units), ``run_s``, ``plan_calls``, ``plan_call_median_s`` and
-        ``plan_call_first_s`` (seconds, None without planning) and, with pose estimates,
-        ``localisation_error_final`` / ``localisation_error_mean`` (maze units).
-    """
-    from .explore import ratio_at
-
-    plan = np.array(res.plan_seconds) if res.plan_seconds else None
-    out = {"ratio_final": ratio_at(res.ratio_curve, steps - 1), "ratio_curve": res.ratio_curve,
-           "info_gain_curve": res.info_curve, "info_gain_final": res.info_curve[-1][1] if res.info_curve else None,
-           "blocked_steps": res.blocked, "pulled_plans": res.pulled,
-           "path_length": float(np.sum(np.hypot(*np.diff(res.poses[:, :2], axis=0).T))),
-           "run_s": res.seconds, "plan_calls": len(res.plan_seconds),
-           "plan_call_median_s": float(np.median(plan)) if plan is not None else None,
-           "plan_call_first_s": float(plan[0]) if plan is not None else None}
-    if res.estimates is not None:
-        err = np.hypot(*(res.estimates[:, :2] - res.poses[:, :2]).T)
-        out["localisation_error_final"] = float(err[-1])
-        out["localisation_error_mean"] = float(err.mean())
-    return out
-
-
-def _ratio_png(results, maze, filename) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg", force=False)
-    import matplotlib.pyplot as plt
-
-    has_info = any(r.info_curve for r in results.values())
-    fig, axes = plt.subplots(1, 2 if has_info else 1, figsize=(10 if has_info else 5.5, 3.6), squeeze=False)
-    colours = {"mi": "tab:blue", "random": "tab:red", "frontier": "tab:green"}
-    try:
-        for m, r in results.items():
-            c = np.array(r.ratio_curve)
-            axes[0, 0].plot(c[:, 0], c[:, 1], c=colours.get(m, "k"), label=m)
-            if has_info and r.info_curve:
-                i = np.array(r.info_curve)
-                axes[0, 1].plot(i[:, 0], i[:, 1], c=colours.get(m, "k"), label=m)
-        axes[0, 0].set_xlabel("step")
-        axes[0, 0].set_ylabel(f"exploration ratio ({maze.tiles} x {maze.tiles} tiles)")
-        axes[0, 0].set_ylim(0, 1.02)
-        axes[0, 0].legend()
-        if has_info:
-            axes[0, 1].set_xlabel("step")
-            axes[0, 1].set_ylabel("information gain KL(q(M) || p(M)) (nats)")
-            axes[0, 1].legend()
-        fig.tight_layout()
-        fig.savefig(filename, dpi=110)
-    finally:
-        plt.close(fig)

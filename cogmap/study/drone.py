@@ -54,7 +54,8 @@ def drone_specs(plan: dict) -> list[dict]:
     changes the keys of the agent's runs and leaves the baselines' runs valid."""
     from dataclasses import asdict
 
-    from cogmap.drone.episode import EpisodeLimits, make_policy
+    from cogmap.drone.methods import make_policy
+    from cogmap.envs.drone_episode import EpisodeLimits
 
     from .config import spec_digest
 
@@ -86,8 +87,9 @@ def _sim(field_seed: int, end_on_collision: bool):
 
 
 def run_drone(spec: dict) -> dict:
-    from cogmap.drone.episode import fly_episode, make_policy
+    from cogmap.drone.methods import make_policy
     from cogmap.drone.run import episode_target
+    from cogmap.envs.drone_episode import fly_episode
 
     field_seed = int(spec["env"][5:])
     sim = _sim(field_seed, LEVELS[spec["level"]])
@@ -110,7 +112,7 @@ def _f(x, d=2) -> str:
 
 
 def summarise_runs(rs: list[dict]) -> dict:
-    from cogmap.drone.episode import summarise
+    from cogmap.envs.drone_episode import summarise
 
     eps = [{**r["result"], "plan_ms": r["result"]["plan_call_ms"],
             "efe_us_per_candidate_median": r["result"]["efe_per_candidate_us"]} for r in rs]

@@ -93,7 +93,6 @@ def dvbf_exploration_specs(plan: dict) -> list[dict]:
 
 def run_dvbf_exploration(spec: dict) -> dict:
     from cogmap.dvbf.explore import ExploreConfig, cache_dir, explore, pretrained_emission
-    from cogmap.dvbf.run import summarise
     from cogmap.envs.maze import make_maze
     from cogmap.planning.mi_exploration import MIConfig
 
@@ -108,7 +107,7 @@ def run_dvbf_exploration(spec: dict) -> dict:
         p = spec["params"]["pretrain"]
         emission = pretrained_emission(cache_dir(), steps=p["steps"], iters=p["iters"])
     res = explore(maze, spec["steps"], cfg, emission=emission)
-    out = summarise(res, maze, spec["steps"])
+    out = res.metrics(spec["steps"])
     out["maze_seed"] = maze.seed
     out["tiles"] = maze.tiles
     # timing fields end in _s or _ms (strip_timings drops them in comparisons)
@@ -122,8 +121,8 @@ def _f(x, d=2) -> str:
 
 
 def dvbf_exploration_report(study_dir: Path, plan, results) -> str:
-    from cogmap.dvbf.explore import ratio_at
     from cogmap.envs.maze import TABLE_II
+    from cogmap.envs.maze_episode import ratio_at
 
     from .tables import md_table, pyplot, save_figure, write_csv
 

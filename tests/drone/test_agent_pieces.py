@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from cogmap.drone import DroneAgent
-from cogmap.drone.episode import make_policy
+from cogmap.drone.methods import make_policy
 from cogmap.genmodel.voxel_map import VoxelMap
 from cogmap.planning.drone_policies import PotentialField, StraightLine
 

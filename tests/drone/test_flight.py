@@ -82,8 +82,9 @@ def test_depth2_avoids_the_crash_of_the_published_one_step_agent():
 def test_a_flight_that_oscillated_reaches_its_target_with_novelty():
     # field 0, episode 4: the published planner shuttles between a few waypoints in front of a band
     # of trees until the 250 s limit; with the EFE discounted at visited places the drone moves on
-    from cogmap.drone.episode import fly_episode, make_policy
+    from cogmap.drone.methods import make_policy
     from cogmap.drone.run import episode_target
+    from cogmap.envs.drone_episode import fly_episode
 
     sim = DroneSim(0)
     try:

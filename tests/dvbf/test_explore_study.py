@@ -7,9 +7,10 @@ import numpy as np
 import pytest
 
 from cogmap.cli import build_parser
-from cogmap.dvbf.explore import ExploreConfig, explore, ratio_at
+from cogmap.dvbf.explore import ExploreConfig, explore
 from cogmap.dvbf.run import explore_run
 from cogmap.envs.maze import exploration_ratio, make_maze
+from cogmap.envs.maze_episode import ratio_at
 from cogmap.envs.maze_poses import start_pose
 from cogmap.planning.maze_explorers import Frontier
 from cogmap.study import run_study

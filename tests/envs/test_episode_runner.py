@@ -100,8 +100,8 @@ def _arity(func) -> int:
 
 
 def test_every_system_episode_and_policy_conforms():
-    from cogmap.drone.episode import DroneEpisode, DronePilot
-    from cogmap.dvbf.explore import MazeEpisode, MazePilot
+    from cogmap.envs.drone_episode import DroneEpisode, DronePilot
+    from cogmap.envs.maze_episode import MazeEpisode, MazePilot
     from cogmap.envs.maze_traversal import MazeRun, Operator
     from cogmap.harness import RoomEpisode
 

@@ -157,3 +157,19 @@ def test_fit_refuses_bad_restarts_and_annealing():
         fit(model, data, anneal_iterations=5, anneal_from=0.0)
     with pytest.raises(ValueError, match="anneal_iterations"):
         fit(model, data, anneal_iterations=-1)
+
+
+def test_the_room_walk_follows_its_moves_and_the_room_model_learns_b_from_flat_counts():
+    from cogmap.genmodel.demo_models import room_model, room_walk
+
+    A, B, label = aliased_room(3, 4, 0.05, 7)
+    obs, acts, places = room_walk(A, B, 200, 3)
+    assert len(obs) == len(places) == 200 and len(acts) == 199
+    for t, u in enumerate(acts):
+        assert B[places[t + 1], places[t], u] == 1.0  # every move is the deterministic one
+    views = np.array([o[0] for o in obs])
+    assert np.mean(views == label[places]) > 0.85  # the place's own view with probability 0.95
+    assert room_walk(A, B, 200, 3)[1] == acts  # seeded
+    true, learner = room_model(A, B), room_model(A, B, conc=0.5)
+    assert np.allclose(true.B[0].to_dense(), B)
+    assert np.allclose(learner.B[0].to_dense(), 1 / 9) and np.allclose(learner.B[0].counts_dense(), 0.5)

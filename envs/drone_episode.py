@@ -1,4 +1,5 @@
-"""One drone episode: plan -> fly the first action -> replan (DRONE.md 2.7-2.8), and its metrics.
+"""One drone episode in the drone field: plan -> fly the first action -> replan (DRONE.md 2.7-2.8),
+its stopping rules and metrics, driven by the episode runner (:func:`cogmap.envs.episode.run`).
 
 Outcomes: success (final distance <= 1.5 m), stuck (over the last 15 s the drone never got more
 than 1 m from where it was 15 s earlier), timeout (250 s simulated or 250 steps), crashed (a
@@ -44,63 +45,6 @@ class EpisodeLimits:
     stuck_distance: float = 1.0
     step_overhead_s: float = 1.0
     success_radius: float = SUCCESS_RADIUS
-
-
-def make_policy(method: str, seed: int = 0):
-    """The policy of a drone method name.
-
-    Parameters
-    ----------
-    method : str
-        ``"agent"`` (hierarchical AIF), ``"agent_published"`` (the published planner, without the
-        novelty, path clearance, tie keeping and contact memory of ``"agent"``),
-        ``"agent_persistent"`` (beliefs kept across steps), ``"no_filter"``, ``"no_epistemic"``,
-        ``"no_novelty"`` (the paper's EFE, not discounted at visited places), ``"agent_depth2"`` /
-        ``"agent_depth3"`` (EFE over
-        waypoint sequences), ``"straight"`` or ``"potential"``.
-    seed : int, optional
-        Seed of the agent's planner, default 0 (unused by the baselines).
-
-    Returns
-    -------
-    DroneAgent or StraightLine or PotentialField
-
-    Raises
-    ------
-    ValueError
-        For an unknown method.
-    """
-    from dataclasses import replace
-
-    from cogmap.planning.drone_policies import PotentialField, StraightLine
-
-    from .agent import DroneAgent, DroneAgentConfig
-
-
-    base = DroneAgentConfig()
-    if method == "agent":
-        return DroneAgent(base, seed)
-    if method == "agent_published":
-        return DroneAgent(DroneAgentConfig.published(), seed)
-    if method == "agent_persistent":
-        return DroneAgent(replace(base, persistent_beliefs=True), seed)
-    if method == "no_filter":
-        return DroneAgent(replace(base, planner=replace(base.planner, use_filter=False)), seed)
-    if method == "no_epistemic":
-        return DroneAgent(replace(base, planner=replace(base.planner, w_epistemic=0.0)), seed)
-    if method == "no_novelty":
-        return DroneAgent(replace(base, planner=replace(base.planner, novelty=False)), seed)
-    if method in ("agent_depth2", "agent_depth3"):
-        return DroneAgent(replace(base, depth=int(method[-1])), seed)
-    if method == "straight":
-        return StraightLine()
-    if method == "potential":
-        return PotentialField()
-    raise ValueError(f"unknown drone method {method!r}; choose from {METHODS}")
-
-
-METHODS = ("agent", "agent_published", "agent_persistent", "no_filter", "no_epistemic", "no_novelty", "agent_depth2",
-           "agent_depth3", "straight", "potential")
 
 
 def _stuck(times, positions, now: float, window: float, dist: float) -> bool:
