@@ -161,15 +161,12 @@ class MazeEpisode(Episode):
         Time steps of the run (the start counts as step 0).
     start : tuple
         ``(pose, scan)`` at the start.
-    progress : callable, optional
-        Called with the step index after each step.
     """
 
-    def __init__(self, sim, maze: Maze, curve_every: int, slam, steps: int, start, progress=None):
+    def __init__(self, sim, maze: Maze, curve_every: int, slam, steps: int, start):
         from cogmap.genmodel.latent_map import kl_map
 
         self.sensors, self.maze, self.curve_every, self.slam, self.steps = sim, maze, curve_every, slam, steps
-        self.progress = progress
         pose, scan = start
         self.record = MazeRun(sim, pose, scan)
         self.curves = MazeCurves({tuple(r) for r in maze.tile_index(pose)}, [(0, exploration_ratio(maze, pose))], [])
@@ -191,8 +188,6 @@ class MazeEpisode(Episode):
             curves.ratio.append((t, len(curves.tiles) / maze.tiles**2))
             if slam is not None and slam.t == t and t % (10 * every) == 0:
                 curves.info.append((t, float(kl_map(slam.params.q_map))))
-        if self.progress is not None:
-            self.progress(t)
         return pose, scan, blocked
 
     def end(self) -> None:

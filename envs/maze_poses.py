@@ -1,13 +1,16 @@
 """Poses in a LiDAR maze: a seeded start, a grid of free poses and pairs of them, and open-loop
-execution of a control sequence in the simulator (the DVBF-LM studies, paper Sections V and VI)."""
+execution of a control sequence in the simulator, and how a navigation is judged (the DVBF-LM
+studies, paper Sections V and VI)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from cogmap.envs.maze import Maze
+from cogmap.genmodel.numerics import wrap_angle
 
 GRID = 5  # 5 x 5 poses per maze
+SUCCESS_RADIUS = 0.05  # Section V-B b: a navigation succeeds within this distance of the goal
 
 
 def start_pose(maze: Maze, seed: int) -> np.ndarray:
@@ -127,3 +130,82 @@ def execute(sim, start, controls) -> tuple[np.ndarray, int]:
         poses.append(pose)
         blocked += int(hit)
     return np.array(poses), blocked
+
+
+def outcome_row(pair, which, plan, executed, blocked, goal) -> dict:
+    """One navigation outcome (Section V-B): a plan executed open loop from ``pair[0]``, judged at
+    goal ``goal``; success is a found plan ending within :data:`SUCCESS_RADIUS` of it.
+
+    Parameters
+    ----------
+    pair : tuple of int
+        ``(start index, goal index)``.
+    which : str
+        The model the plan was made with (``"learned"``, ``"true"``, ...).
+    plan : object
+        The plan (:class:`cogmap.planning.hybrid_astar.Plan`: ``found``, ``length``, ``controls``,
+        ``expansions``, ``queries``, ``seconds``, ``reason``).
+    executed : numpy.ndarray
+        ``(T, 3)`` poses the execution went through (:func:`execute`).
+    blocked : int
+        Moves a wall stopped.
+    goal : numpy.ndarray
+        ``(3,)`` the true goal pose.
+
+    Returns
+    -------
+    dict
+        ``start``, ``goal``, ``model``, ``found``, ``success``, ``final_error`` and lengths (maze
+        units), ``heading_error`` (radians), ``blocked_moves`` and the planner's counts and time.
+    """
+    final = executed[-1]
+    err = float(np.hypot(*(final[:2] - goal[:2])))
+    walked = float(np.sum(np.hypot(*np.diff(executed[:, :2], axis=0).T))) if len(executed) > 1 else 0.0
+    return {"start": pair[0], "goal": pair[1], "model": which, "found": plan.found,
+            "success": bool(plan.found and err <= SUCCESS_RADIUS), "final_error": err,
+            "heading_error": float(abs(wrap_angle(final[2] - goal[2]))),
+            "plan_length": plan.length if plan.found else None, "executed_length": walked,
+            "blocked_moves": blocked, "controls": len(plan.controls), "expansions": plan.expansions,
+            "queries": plan.queries, "plan_s": plan.seconds, "reason": plan.reason}
+
+
+def summarise(rows: list[dict]) -> dict:
+    """Success rate per model, path length ratio of each learned model to the true simulator over pairs
+    both found (``length_ratio`` for ``learned``, ``length_ratio_<name>`` for others), plan times.
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows of :func:`outcome_row` (those of :func:`cogmap.dvbf.navigate.navigate_pairs`).
+
+    Returns
+    -------
+    dict
+        Per model: ``pairs``, ``found``, ``success``, ``success_rate``, ``collided`` (plans with a
+        blocked move), median and mean ``plan_s`` (seconds), median expansions; and for each model
+        other than ``true`` the ``pairs``, ``mean``, ``median`` and ``max`` of its plan length over
+        the true simulator's (None when no pair qualifies).
+    """
+    out = {}
+    models = sorted({r["model"] for r in rows})
+    for m in models:
+        rs = [r for r in rows if r["model"] == m]
+        t = np.array([r["plan_s"] for r in rs])
+        out[m] = {"pairs": len(rs), "found": int(sum(r["found"] for r in rs)),
+                  "success": int(sum(r["success"] for r in rs)),
+                  "success_rate": float(np.mean([r["success"] for r in rs])) if rs else None,
+                  "collided": int(sum(r["blocked_moves"] > 0 for r in rs)),
+                  "plan_s_median": float(np.median(t)) if len(t) else None,
+                  "plan_s_mean": float(np.mean(t)) if len(t) else None,
+                  "expansions_median": float(np.median([r["expansions"] for r in rs])) if rs else None}
+    by = {(r["start"], r["goal"], r["model"]): r for r in rows}
+    for m in models:
+        if m == "true" or "true" not in models:
+            continue
+        ratios = [by[(a, b, m)]["plan_length"] / by[(a, b, "true")]["plan_length"]
+                  for (a, b, kind) in by if kind == "true" and by[(a, b, "true")]["found"]
+                  and by.get((a, b, m), {}).get("found") and by[(a, b, "true")]["plan_length"] > 0]
+        out["length_ratio" if m == "learned" else f"length_ratio_{m}"] = {
+            "pairs": len(ratios), "mean": float(np.mean(ratios)) if ratios else None,
+            "median": float(np.median(ratios)) if ratios else None, "max": float(np.max(ratios)) if ratios else None}
+    return out

@@ -315,7 +315,8 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
     return emission
 
 
-def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=None) -> ExploreResult:
+def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress: bool = False,
+            desc: str | None = None) -> ExploreResult:
     """Run one exploration of ``steps`` time steps (the start pose counts as step 0).
 
     Parameters
@@ -328,8 +329,10 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         Method and settings.
     emission : optional
         A pretrained emission network, kept frozen in the online SLAM; None learns it online.
-    progress : callable, optional
-        Called with the step index after each step.
+    progress : bool, optional
+        Show the runner's progress bar, default False.
+    desc : str, optional
+        Its description (default ``cfg.method``).
 
     Returns
     -------
@@ -368,8 +371,8 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress=
         else:
             policy = (RandomWalk(cfg, cfg.seed) if cfg.method == "random"
                       else Frontier(maze, cfg, cfg.seed, sim.lidar_range))
-        episode = MazeEpisode(sim, maze, cfg.curve_every, slam, steps, (pose, scan), progress)
-        run(episode, MazePilot(policy), steps - 1, outcome=(pose, scan, 0))
+        episode = MazeEpisode(sim, maze, cfg.curve_every, slam, steps, (pose, scan))
+        run(episode, MazePilot(policy), steps - 1, outcome=(pose, scan, 0), progress=progress, desc=desc or cfg.method)
         tr, curves = episode.record.traversal(), episode.curves
         est = slam.estimates[:steps].copy() if slam is not None else None
         return ExploreResult(tr.poses, tr.controls, tr.scans, est, curves.ratio, curves.info,

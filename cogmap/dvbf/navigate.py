@@ -24,14 +24,13 @@ from pathlib import Path
 import numpy as np
 
 from cogmap.envs.maze import Maze, make_maze
-from cogmap.envs.maze_poses import GRID, execute, grid_poses, pose_pairs
+from cogmap.envs.maze_poses import GRID, SUCCESS_RADIUS, execute, grid_poses, outcome_row, pose_pairs, summarise
 from cogmap.envs.maze_render import save_plans_png
 from cogmap.genmodel.dvbf_scan import scan_models
-from cogmap.genmodel.numerics import wrap_angle
 from cogmap.inference.goal_encoding import encode_goals
-from cogmap.planning.hybrid_astar import HybridAStarConfig, Plan, cost_grid, plan_path
+from cogmap.planning.hybrid_astar import HybridAStarConfig, cost_grid, plan_path
 
-SUCCESS_RADIUS = 0.05  # Section V-B b
+
 def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0, pretrain_maze: int | None = None,
                 pretrain_steps: int = 2000, pretrain_iters: int = 1500, hidden: int = 64, map_side: int | None = None,
                 sigma_e: float = 0.03):
@@ -106,18 +105,6 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     return params, cfg, info
 
 
-def _row(pair, which, plan: Plan, executed, blocked, goal) -> dict:
-    final = executed[-1]
-    err = float(np.hypot(*(final[:2] - goal[:2])))
-    walked = float(np.sum(np.hypot(*np.diff(executed[:, :2], axis=0).T))) if len(executed) > 1 else 0.0
-    return {"start": pair[0], "goal": pair[1], "model": which, "found": plan.found,
-            "success": bool(plan.found and err <= SUCCESS_RADIUS), "final_error": err,
-            "heading_error": float(abs(wrap_angle(final[2] - goal[2]))),
-            "plan_length": plan.length if plan.found else None, "executed_length": walked,
-            "blocked_moves": blocked, "controls": len(plan.controls), "expansions": plan.expansions,
-            "queries": plan.queries, "plan_s": plan.seconds, "reason": plan.reason}
-
-
 def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config: HybridAStarConfig,
                    progress=None, targets: dict | None = None) -> tuple[list[dict], dict]:
     """Plan every pair with every scan function (``{"learned": fn, "true": fn}``) and execute each plan
@@ -146,9 +133,9 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
     Returns
     -------
     rows : list of dict
-        One per (pair, model): ``found``, ``success`` (final position within
-        :data:`SUCCESS_RADIUS` of the goal, Section V-B), ``final_error`` and lengths in maze units,
-        ``heading_error`` in radians, ``blocked_moves``, planner counts and ``plan_s`` seconds.
+        One per (pair, model), from :func:`~cogmap.envs.maze_poses.outcome_row`: ``found``,
+        ``success`` (final position within :data:`~cogmap.envs.maze_poses.SUCCESS_RADIUS` of the goal,
+        Section V-B), errors, lengths, planner counts and ``plan_s`` seconds.
     extra : dict
         ``paths`` and ``grid_s`` as above.
     """
@@ -167,55 +154,13 @@ def navigate_pairs(maze: Maze, scan_fns: dict, poses: np.ndarray, pairs, config:
                 goal = targets[name][j] if name in targets else poses[j]
                 plan = plan_path(poses[i], goal, fn, maze.size, config, grid=grids[name][0])
                 executed, blocked = execute(sim, poses[i], plan.controls) if plan.found else (poses[i][None], 0)
-                rows.append(_row((i, j), name, plan, executed, blocked, poses[j]))
+                rows.append(outcome_row((i, j), name, plan, executed, blocked, poses[j]))
                 paths[name].append(((i, j), plan, executed, poses[j]))
             if progress is not None:
                 progress(n + 1)
     finally:
         sim.close()
     return rows, {"paths": paths, "grid_s": {k: v[1] for k, v in grids.items()}}
-
-
-def summarise(rows: list[dict]) -> dict:
-    """Success rate per model, path length ratio of each learned model to the true simulator over pairs
-    both found (``length_ratio`` for ``learned``, ``length_ratio_<name>`` for others), plan times.
-
-    Parameters
-    ----------
-    rows : list of dict
-        The rows of :func:`navigate_pairs`.
-
-    Returns
-    -------
-    dict
-        Per model: ``pairs``, ``found``, ``success``, ``success_rate``, ``collided`` (plans with a
-        blocked move), median and mean ``plan_s`` (seconds), median expansions; and for each model
-        other than ``true`` the ``pairs``, ``mean``, ``median`` and ``max`` of its plan length over
-        the true simulator's (None when no pair qualifies).
-    """
-    out = {}
-    models = sorted({r["model"] for r in rows})
-    for m in models:
-        rs = [r for r in rows if r["model"] == m]
-        t = np.array([r["plan_s"] for r in rs])
-        out[m] = {"pairs": len(rs), "found": int(sum(r["found"] for r in rs)),
-                  "success": int(sum(r["success"] for r in rs)),
-                  "success_rate": float(np.mean([r["success"] for r in rs])) if rs else None,
-                  "collided": int(sum(r["blocked_moves"] > 0 for r in rs)),
-                  "plan_s_median": float(np.median(t)) if len(t) else None,
-                  "plan_s_mean": float(np.mean(t)) if len(t) else None,
-                  "expansions_median": float(np.median([r["expansions"] for r in rs])) if rs else None}
-    by = {(r["start"], r["goal"], r["model"]): r for r in rows}
-    for m in models:
-        if m == "true" or "true" not in models:
-            continue
-        ratios = [by[(a, b, m)]["plan_length"] / by[(a, b, "true")]["plan_length"]
-                  for (a, b, kind) in by if kind == "true" and by[(a, b, "true")]["found"]
-                  and by.get((a, b, m), {}).get("found") and by[(a, b, "true")]["plan_length"] > 0]
-        out["length_ratio" if m == "learned" else f"length_ratio_{m}"] = {
-            "pairs": len(ratios), "mean": float(np.mean(ratios)) if ratios else None,
-            "median": float(np.median(ratios)) if ratios else None, "max": float(np.max(ratios)) if ratios else None}
-    return out
 
 
 def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40, seed: int = 0,
@@ -267,7 +212,7 @@ def navigate_run(maze_seed: int, out: Path | None = None, pairs: int | None = 40
     -------
     dict
         The maze, seed, number of pairs, :data:`SUCCESS_RADIUS`, the model's ``info``, ``grid_s``
-        and the entries of :func:`summarise`; with ``observation_goals`` also ``goal_errors``.
+        and the entries of :func:`~cogmap.envs.maze_poses.summarise`; with ``observation_goals`` also ``goal_errors``.
 
     Raises
     ------

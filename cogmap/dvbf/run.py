@@ -24,35 +24,6 @@ from cogmap.inference.online_slam import SLAMConfig, online_slam, path_integrati
 from .maze_model import NOISE, maze_model
 
 
-def slam_traversal(maze_seed: int, steps: int, seed: int, complexity: str = "moderate", corridor: str = "medium",
-                   noise: ActuationNoise = NOISE):
-    """The maze and the seeded operator traversal (with actuation ``noise``, default :data:`NOISE`) that a SLAM
-    run of ``slam_run(maze_seed, steps, seed=seed)`` filters; other localisers compared on it call this too.
-
-    Parameters
-    ----------
-    maze_seed : int
-        Seed of the maze.
-    steps : int
-        Time steps of the traversal (the start counts as step 0).
-    seed : int
-        Seed of the traversal.
-    complexity, corridor : str
-        Maze family (Table II).
-    noise : ActuationNoise
-        Actuation noise of the traversal.
-
-    Returns
-    -------
-    maze : Maze
-        The maze.
-    traversal : Traversal
-        True poses, commanded controls, scans and blocked flags.
-    """
-    maze = make_maze(maze_seed, complexity, corridor)
-    return maze, traverse(maze, steps, seed=seed, noise=noise)
-
-
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
              complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
              pretrain_steps: int = 2000, pretrain_iters: int = 1500, offline: bool = False,
@@ -110,7 +81,8 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    maze, tr = slam_traversal(maze_seed, steps, seed, complexity, corridor, noise)
+    maze = make_maze(maze_seed, complexity, corridor)
+    tr = traverse(maze, steps, seed=seed, noise=noise)  # the seeded operator traversal the filter sees
     model = maze_model(maze, noise)
     emission = None
     if pretrain_maze is not None:
@@ -245,14 +217,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     results, metrics = {}, {"maze_seed": maze_seed, "complexity": complexity, "corridor": corridor, "steps": steps,
                             "budget": maze.step_budget, "tiles": maze.tiles, "seed": seed, "methods": {}}
     for m, c in cfgs.items():
-        bar = None
-        if progress:
-            from tqdm import tqdm
-
-            bar = tqdm(total=steps - 1, desc=m, unit="step")
-        res = explore(maze, steps, c, emission=emission, progress=(lambda _t, b=bar: b.update(1)) if bar else None)
-        if bar is not None:
-            bar.close()
+        res = explore(maze, steps, c, emission=emission, progress=progress, desc=m)
         results[m] = res
         metrics["methods"][m] = res.metrics(steps)
     agent = next((m for m in ("mi", "mi-pull") if m in results and results[m].params is not None), None)

@@ -166,7 +166,7 @@ def run_navigation(spec: dict) -> dict:
 
 
 def nav_report(study_dir: Path, plan, results) -> str:
-    from cogmap.dvbf.navigate import summarise
+    from cogmap.envs.maze_poses import summarise
 
     from .tables import md_table, pyplot, save_figure, write_csv
 
@@ -275,7 +275,7 @@ def _encoder_table(results) -> str:
 
 def _pooled(rows):
     """Summaries over several mazes: pair keys made unique per maze and seed."""
-    from cogmap.dvbf.navigate import summarise
+    from cogmap.envs.maze_poses import summarise
 
     keyed = [{**x, "start": (x["maze"], x["seed"], x["start"])} for x in rows]
     return summarise(keyed)

@@ -130,13 +130,16 @@ def _run_mcl(spec: dict) -> dict:
     """The Cartographer stand-in on the traversal ``slam_run`` would see (same maze, seed and noise)."""
     import time
 
-    from cogmap.dvbf.run import slam_traversal
+    from cogmap.dvbf.maze_model import NOISE
+    from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_sim import LIDAR_RANGE
+    from cogmap.envs.maze_traversal import traverse
     from cogmap.inference.grid_mcl import MCLConfig, mcl_localise
     from cogmap.inference.online_slam import path_integration
 
     tic = time.perf_counter()
-    maze, tr = slam_traversal(_maze_seed(spec["env"]), spec["steps"], spec["seed"])
+    maze = make_maze(_maze_seed(spec["env"]), "moderate", "medium")  # slam_run's defaults
+    tr = traverse(maze, spec["steps"], seed=spec["seed"], noise=NOISE)
     cfg = MCLConfig(**{**spec["method_options"]["mcl"], "seed": spec["seed"]})
     means, _, _ = mcl_localise(maze.occupancy(cfg.resolution), maze.size, tr.poses[0], tr.controls, tr.scans, cfg,
                                LIDAR_RANGE)

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from cogmap.cli import build_parser
-from cogmap.dvbf.navigate import learn_model, navigate_pairs, navigate_run, summarise
+from cogmap.dvbf.navigate import learn_model, navigate_pairs, navigate_run
 from cogmap.envs.maze import make_maze
-from cogmap.envs.maze_poses import execute, grid_poses, pose_pairs
+from cogmap.envs.maze_poses import execute, grid_poses, pose_pairs, summarise
 from cogmap.envs.maze_sim import MazeSim
 from cogmap.genmodel.dvbf_scan import learned_scan_fn
 from cogmap.planning.hybrid_astar import HybridAStarConfig, plan_path
