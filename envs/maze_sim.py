@@ -33,6 +33,10 @@ class ActuationNoise:
     trans_frac: float = 0.0
 
 
+#: the robot's actuation noise in every DVBF-LM run and study (heading std per step, translation fraction)
+ROBOT_NOISE = ActuationNoise(rot_std=0.005, trans_frac=0.05)
+
+
 class MazeSim:
     """A maze in its own pybullet client, one point agent, LiDAR by ``rayTestBatch``."""
 

@@ -186,3 +186,27 @@ def transition_log_prob(z_next: jax.Array, z: jax.Array, u: jax.Array, sigma_t) 
     d = z_next - kinematic_mean(z, u)
     d = d.at[..., 2].set(wrap_angle(d[..., 2]))
     return -0.5 * jnp.sum((d / s) ** 2, -1) - jnp.sum(jnp.log(s)) - 1.5 * LOG_2PI
+
+
+def maze_config(extent: float, map_side: int, rot_std: float, hidden: int = 64, sigma_xy: float = 0.0005) -> DVBFConfig:
+    """The DVBF-LM configuration the runs and studies use for a maze: its extent and map side,
+    ``hidden`` units, and a transition noise of ``sigma_xy`` in x and y and the actuation's heading std.
+
+    Parameters
+    ----------
+    extent : float
+        Side of the world (the maze's ``size``).
+    map_side : int
+        Map cells per side (the maze's ``map_side``, Table II).
+    rot_std : float
+        Heading std per step of the robot's actuation, radians.
+    hidden : int, optional
+        Hidden units of the emission network, default 64.
+    sigma_xy : float, optional
+        Transition std of x and y per step, default 0.0005.
+
+    Returns
+    -------
+    DVBFConfig
+    """
+    return DVBFConfig(extent=extent, map_side=map_side, hidden=hidden, sigma_t=(sigma_xy, sigma_xy, rot_std))

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from dataclasses import asdict
 from pathlib import Path
 
@@ -32,6 +33,36 @@ def save_params(params, cfg: DVBFConfig, out: Path) -> None:
     arrays = {_array_name(path): np.asarray(v) for path, v in leaves}
     np.savez_compressed(out / "model.npz", **arrays)
     (out / "model.json").write_text(json.dumps({"config": asdict(cfg), "arrays": sorted(arrays)}, indent=1))
+
+
+def save_emission_once(emission, cfg: DVBFConfig, out: Path) -> None:
+    """Store an emission network as the model directory ``out`` (with a fresh q(M)), atomically: it
+    is written to a new folder beside ``out`` and renamed, so a reader sees all of it or nothing, and
+    when another process stored it first its copy is kept.
+
+    Parameters
+    ----------
+    emission : object
+        The emission network.
+    cfg : DVBFConfig
+        Its model.
+    out : pathlib.Path
+        The model directory to create.
+    """
+    import tempfile
+
+    import jax
+
+    from .elbo import init_params
+
+    out = Path(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(dir=out.parent))
+    save_params(init_params(cfg, jax.random.PRNGKey(0))._replace(emission=emission), cfg, tmp)
+    try:
+        tmp.rename(out)
+    except OSError:  # another process wrote it first
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 #: largest ``model.json`` of a DVBF-LM run (it holds the configuration and the array names: a few kB)

@@ -59,12 +59,12 @@ import numpy as np
 from cogmap.envs.maze import Maze
 from cogmap.envs.maze_episode import ExploreResult, MazeEpisode, MazePilot
 from cogmap.envs.maze_poses import start_pose
+from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
 from cogmap.envs.maze_sim import MazeSim
+from cogmap.genmodel.dvbf import maze_config
 from cogmap.planning.maze_explorers import Frontier, RandomWalk
 from cogmap.planning.mi_exploration import MIConfig
 from cogmap.planning.mi_planner import MIPlanner
-
-from .maze_model import NOISE, maze_model
 
 METHODS = ("mi", "random", "frontier")
 
@@ -286,7 +286,7 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
 
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_traversal import traverse
-    from cogmap.inference.dvbf_files import load_params, save_params
+    from cogmap.inference.dvbf_files import load_params, save_emission_once
     from cogmap.inference.online_slam import pretrain_emission
 
     cache = None
@@ -296,22 +296,10 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
             return load_params(cache)[0].emission
     maze = make_maze(0)
     tr = traverse(maze, steps, seed=seed + 1000, noise=NOISE)
-    model = maze_model(maze)
+    model = maze_config(maze.size, maze.map_side, NOISE.rot_std)
     emission, _ = pretrain_emission(tr.poses, tr.scans, model, iters=iters, seed=seed)
     if cache is not None:
-        import tempfile
-
-        from cogmap.inference.elbo import init_params
-
-        cache.parent.mkdir(parents=True, exist_ok=True)
-        tmp = Path(tempfile.mkdtemp(dir=cache.parent))
-        import jax
-
-        save_params(init_params(model, jax.random.PRNGKey(0))._replace(emission=emission), model, tmp)
-        try:
-            tmp.rename(cache)
-        except OSError:  # another process wrote it first
-            pass
+        save_emission_once(emission, model, cache)
     return emission
 
 
@@ -359,7 +347,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress:
         if cfg.method == "mi" or cfg.learn_map:
             from cogmap.inference.online_slam import OnlineSLAM, SLAMConfig
 
-            model = maze_model(maze)
+            model = maze_config(maze.size, maze.map_side, NOISE.rot_std)
             sc = SLAMConfig(model=model, seed=cfg.seed, train_every=cfg.train_every, train_iters=cfg.train_iters,
                             freeze_emission=emission is not None)
             slam = OnlineSLAM(pose, sc, steps + cfg.train_every, emission=emission, first_scan=scan)

@@ -79,11 +79,10 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     ValueError
         If ``pretrain_maze`` is ``maze`` itself.
     """
+    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
     from cogmap.envs.maze_traversal import traverse
     from cogmap.genmodel.dvbf import DVBFConfig
     from cogmap.inference.online_slam import fit_known_poses
-
-    from .maze_model import NOISE
 
     if pretrain_maze is not None and pretrain_maze == maze.seed:
         raise ValueError(f"learn_model: the emission is pretrained on maze {pretrain_maze}; learn another maze")

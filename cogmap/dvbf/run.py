@@ -16,12 +16,12 @@ from pathlib import Path
 import numpy as np
 
 from cogmap.envs.maze import make_maze
+from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
 from cogmap.envs.maze_sim import ActuationNoise
 from cogmap.envs.maze_traversal import traverse
+from cogmap.genmodel.dvbf import maze_config
 from cogmap.inference.dvbf_files import save_params
 from cogmap.inference.online_slam import SLAMConfig, online_slam, path_integration, pretrain_emission
-
-from .maze_model import NOISE, maze_model
 
 
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
@@ -83,7 +83,7 @@ def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: boo
     out.mkdir(parents=True, exist_ok=True)
     maze = make_maze(maze_seed, complexity, corridor)
     tr = traverse(maze, steps, seed=seed, noise=noise)  # the seeded operator traversal the filter sees
-    model = maze_model(maze, noise)
+    model = maze_config(maze.size, maze.map_side, noise.rot_std)
     emission = None
     if pretrain_maze is not None:
         first = traverse(make_maze(pretrain_maze, complexity, corridor), pretrain_steps, seed=seed + 1000, noise=noise)

@@ -67,7 +67,7 @@ def _maze_seed(env: str) -> int:
 
 
 def dvbf_slam_specs(plan: dict) -> list[dict]:
-    from cogmap.dvbf.maze_model import NOISE
+    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
     from cogmap.inference.grid_mcl import MCLConfig
     from cogmap.inference.offline_slam import OfflineConfig
     from cogmap.inference.online_slam import SLAMConfig
@@ -130,9 +130,9 @@ def _run_mcl(spec: dict) -> dict:
     """The Cartographer stand-in on the traversal ``slam_run`` would see (same maze, seed and noise)."""
     import time
 
-    from cogmap.dvbf.maze_model import NOISE
     from cogmap.envs.maze import make_maze
     from cogmap.envs.maze_sim import LIDAR_RANGE
+    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
     from cogmap.envs.maze_traversal import traverse
     from cogmap.inference.grid_mcl import MCLConfig, mcl_localise
     from cogmap.inference.online_slam import path_integration

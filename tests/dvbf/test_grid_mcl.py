@@ -53,7 +53,7 @@ def test_bad_input_is_refused():
 
 
 def test_mcl_on_the_true_map_beats_path_integration_on_a_traversal():
-    from cogmap.dvbf.maze_model import NOISE
+    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
     from cogmap.inference.online_slam import path_integration
 
     maze = make_maze(2)

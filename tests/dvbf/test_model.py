@@ -173,6 +173,23 @@ def test_a_saved_model_loads_back(tmp_path):
     assert np.array_equal(np.asarray(params.q_map.mean), arrays["q_map/mean"])
 
 
+def test_an_emission_is_stored_once_and_whole(tmp_path):
+    from cogmap.inference.dvbf_files import load_params, save_emission_once
+    from cogmap.inference.elbo import init_params
+
+    cfg = DVBFConfig(map_side=4, n_radii=3, hidden=8, depth=1)
+    first = init_params(cfg, jax.random.PRNGKey(1)).emission
+    second = init_params(cfg, jax.random.PRNGKey(2)).emission
+    out = tmp_path / "cache" / "emission"
+    save_emission_once(first, cfg, out)
+    save_emission_once(second, cfg, out)  # another process came second: the first copy stays
+    stored = load_params(out)[0].emission
+    leaves = [np.asarray(x) for x in jax.tree_util.tree_leaves(eqx.filter(stored, eqx.is_array))]
+    want = [np.asarray(x) for x in jax.tree_util.tree_leaves(eqx.filter(first, eqx.is_array))]
+    assert all(np.array_equal(a, b) for a, b in zip(leaves, want, strict=True))
+    assert sorted(p.name for p in out.parent.iterdir()) == ["emission"]  # no half-written folder left
+
+
 @pytest.mark.parametrize("case", ["nan", "shape", "missing", "extra", "hidden", "unknown field"])
 def test_a_damaged_model_file_is_refused_naming_the_array_or_field(tmp_path, case):
     import json
