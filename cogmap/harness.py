@@ -158,15 +158,16 @@ class RoomEpisode(EpisodeContract):
         The record to extend.
     dist : float
         Distance driven so far, metres.
-    on_step, stop, stop_coverage, after_step
+    on_step, stop, stop_coverage, after_step, moved
         As in :func:`run_episode`.
     """
 
-    def __init__(self, sim, ep: Episode, dist: float, on_step=None, stop=None, stop_coverage=None, after_step=None):
-        self.sensors, self.ep, self.dist = sim, ep, dist
+    def __init__(self, sim, ep: Episode, dist: float, on_step=None, stop=None, stop_coverage=None, after_step=None,
+                 moved: bool | None = None):
+        self.sensors, self.ep, self.dist, self.moved = sim, ep, dist, moved
         self.tracker = coverage_tracker(sim)
         self.on_step, self.stop_rule, self.stop_coverage, self.after_step = on_step, stop, stop_coverage, after_step
-        self.moved, self.last_status = None, {}
+        self.last: Command | None = None
 
     def stop(self) -> str | None:
         sweep(self.sensors, self.tracker)
@@ -186,7 +187,7 @@ class RoomEpisode(EpisodeContract):
             step=len(ep.rows), true_x=true[0], true_y=true[1], true_yaw=true[2], odom_x=odom[0], odom_y=odom[1],
             odom_yaw=odom[2], **cmd.row, moved=self.moved, coverage=cov, distance=self.dist, decision_ms=ms,
         ))
-        self.last_status = dict(cov=f"{cov:.0%}", **cmd.status)
+        self.last = cmd
         if cmd.done:
             return "done"
         if self.on_step is not None:
@@ -208,7 +209,7 @@ class RoomEpisode(EpisodeContract):
         return None
 
     def status(self) -> dict:
-        return self.last_status
+        return dict(cov=f"{self.tracker.coverage:.0%}", **(self.last.status if self.last is not None else {}))
 
     def end(self) -> None:
         sweep(self.sensors, self.tracker)
@@ -261,7 +262,7 @@ def run_episode(sim, policy: Policy, steps: int, *, progress: bool = False, epis
 
     ep = episode if episode is not None else Episode()
     dist = distance if distance is not None else (ep.distance[-1] if ep.distance else 0.0)
-    room = RoomEpisode(sim, ep, dist, on_step=on_step, stop=stop, stop_coverage=stop_coverage, after_step=after_step)
-    room.moved = moved
+    room = RoomEpisode(sim, ep, dist, on_step=on_step, stop=stop, stop_coverage=stop_coverage, after_step=after_step,
+                       moved=moved)
     run(room, policy, steps, outcome=moved, progress=progress, desc=desc)
     return ep

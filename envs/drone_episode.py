@@ -130,6 +130,8 @@ class DroneEpisode(Episode):
         start = sim.reset()
         policy.reset(target, start)
         self.d0 = float(np.linalg.norm(target - start))
+        replan = getattr(getattr(policy, "config", None), "replan_distance", None)
+        self.replan_distance = replan if policy.replans_in_flight else None
         self.trace = DroneTrace([0.0], [start.copy()])
 
     def stop(self) -> str | None:
@@ -152,9 +154,7 @@ class DroneEpisode(Episode):
     def act(self, dec):
         sim, policy, tr = self.sensors, self.policy, self.trace
         pos = sim.position.copy()
-        replan_d = getattr(getattr(policy, "config", None), "replan_distance", None)
-        flight = sim.fly_to(dec.waypoint, dec.speed, replan_distance=replan_d if policy.replans_in_flight else None,
-                            on_scan=policy.observe)
+        flight = sim.fly_to(dec.waypoint, dec.speed, replan_distance=self.replan_distance, on_scan=policy.observe)
         if flight.contact is not None:
             policy.observe_contact(flight.contact)
         sim.advance(self.limits.step_overhead_s)

@@ -66,7 +66,8 @@ def run(episode: Episode, policy: EpisodePolicy, steps: int | None, *, outcome=N
         t0 = time.perf_counter()
         action = policy.step(sensed)
         why = episode.decided(action, 1e3 * (time.perf_counter() - t0))
-        bar.set_postfix(episode.status())
+        if progress:
+            bar.set_postfix(episode.status())
         if why is not None:
             reason = why
             break

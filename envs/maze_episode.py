@@ -19,6 +19,13 @@ from .maze import Maze, exploration_ratio
 from .maze_traversal import MazeRun
 
 
+def _information(slam) -> float:
+    """``KL(q(M) || p(M))`` of the SLAM's map, nats (jax is imported only when a run has a map)."""
+    from cogmap.genmodel.latent_map import kl_map
+
+    return float(kl_map(slam.params.q_map))
+
+
 @dataclass
 class ExploreResult:
     """One exploration run (what :func:`cogmap.dvbf.explore.explore` returns). Lengths are in maze
@@ -164,18 +171,14 @@ class MazeEpisode(Episode):
     """
 
     def __init__(self, sim, maze: Maze, curve_every: int, slam, steps: int, start):
-        from cogmap.genmodel.latent_map import kl_map
-
         self.sensors, self.maze, self.curve_every, self.slam, self.steps = sim, maze, curve_every, slam, steps
         pose, scan = start
         self.record = MazeRun(sim, pose, scan)
         self.curves = MazeCurves({tuple(r) for r in maze.tile_index(pose)}, [(0, exploration_ratio(maze, pose))], [])
         if slam is not None:
-            self.curves.info.append((0, float(kl_map(slam.params.q_map))))
+            self.curves.info.append((0, _information(slam)))
 
     def act(self, u):
-        from cogmap.genmodel.latent_map import kl_map
-
         maze, every, slam, curves = self.maze, self.curve_every, self.slam, self.curves
         pose, scan, blocked = self.record.act(u)
         t = len(self.record.poses) - 1
@@ -187,17 +190,15 @@ class MazeEpisode(Episode):
         if t % every == 0 or t == self.steps - 1:
             curves.ratio.append((t, len(curves.tiles) / maze.tiles**2))
             if slam is not None and slam.t == t and t % (10 * every) == 0:
-                curves.info.append((t, float(kl_map(slam.params.q_map))))
+                curves.info.append((t, _information(slam)))
         return pose, scan, blocked
 
     def end(self) -> None:
-        from cogmap.genmodel.latent_map import kl_map
-
         if self.slam is not None:
             self.slam.flush()
             last = self.steps - 1
             if self.curves.info[-1][0] != last:
-                self.curves.info.append((last, float(kl_map(self.slam.params.q_map))))
+                self.curves.info.append((last, _information(self.slam)))
 
 
 def ratio_at(curve, step: int) -> float:

@@ -50,8 +50,9 @@ def check_entry(func: str, kind: str, name: str, obj, table: Mapping, builtin: C
         The built-in names, which cannot be replaced.
     overwrite : bool
         Whether a name registered earlier may be replaced.
-    expected : str, optional
-        What ``obj`` should be, for the message (e.g. ``"a callable factory(seed) -> Layout"``).
+    expected : str or None, optional
+        What ``obj`` should be, for the message (e.g. ``"a callable factory(seed) -> Layout"``);
+        None accepts an object that is not callable.
     same_again : bool, optional
         Whether registering the very same object again under its name is accepted (default True;
         a registry whose registration has side effects, such as a Gymnasium id, passes False).
@@ -62,11 +63,11 @@ def check_entry(func: str, kind: str, name: str, obj, table: Mapping, builtin: C
     Raises
     ------
     TypeError
-        ``obj`` is not callable, or does not meet ``protocol``.
+        ``obj`` is not callable (when ``expected`` is given), or does not meet ``protocol``.
     ValueError
         ``name`` is built in, or taken and ``overwrite`` is false.
     """
-    if not callable(obj):
+    if expected is not None and not callable(obj):
         raise TypeError(f"{func}('{name}'): expected {expected}, got {type(obj).__name__}")
     if protocol is not None:
         check_conforms(func, kind, name, obj, protocol)
@@ -196,17 +197,8 @@ class Registry:
         test = accepts_test(f"{self.func}('{name}')", accepts)
         if self.check is not None:
             self.check(name, entry)
-        if self.expected is not None:
-            check_entry(self.func, self.kind, name, entry, self._entries, self._builtin, overwrite,
-                        expected=self.expected, protocol=self.protocol)
-        else:
-            if self.protocol is not None:
-                check_conforms(self.func, self.kind, name, entry, self.protocol)
-            again = self._entries.get(name) is entry
-            if name in self._builtin and not again:
-                raise ValueError(f"{self.func}: '{name}' is a built-in {self.kind}; choose another name")
-            if name in self._entries and not overwrite and not again:
-                raise ValueError(f"{self.func}: a {self.kind} named '{name}' exists (pass overwrite=True)")
+        check_entry(self.func, self.kind, name, entry, self._entries, self._builtin, overwrite,
+                    expected=self.expected, protocol=self.protocol)
         self._entries[name] = entry
         self._accepts[name] = test
         return entry
