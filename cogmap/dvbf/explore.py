@@ -59,8 +59,7 @@ import numpy as np
 from cogmap.envs.maze import Maze
 from cogmap.envs.maze_episode import ExploreResult, MazeEpisode, MazePilot
 from cogmap.envs.maze_poses import start_pose
-from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
-from cogmap.envs.maze_sim import MazeSim
+from cogmap.envs.maze_sim import ROBOT_NOISE, MazeSim
 from cogmap.genmodel.dvbf import maze_config
 from cogmap.planning.maze_explorers import Frontier, RandomWalk
 from cogmap.planning.mi_exploration import MIConfig
@@ -295,8 +294,8 @@ def pretrained_emission(cache_dir=None, seed: int = 0, steps: int = 2000, iters:
         if (cache / "model.json").is_file():
             return load_params(cache)[0].emission
     maze = make_maze(0)
-    tr = traverse(maze, steps, seed=seed + 1000, noise=NOISE)
-    model = maze_config(maze.size, maze.map_side, NOISE.rot_std)
+    tr = traverse(maze, steps, seed=seed + 1000, noise=ROBOT_NOISE)
+    model = maze_config(maze.size, maze.map_side, ROBOT_NOISE.rot_std)
     emission, _ = pretrain_emission(tr.poses, tr.scans, model, iters=iters, seed=seed)
     if cache is not None:
         save_emission_once(emission, model, cache)
@@ -338,7 +337,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress:
 
     if steps < 2:
         raise ValueError(f"explore: steps must be >= 2, got {steps}")
-    sim = MazeSim(maze, noise=NOISE, seed=cfg.seed + 1)
+    sim = MazeSim(maze, noise=ROBOT_NOISE, seed=cfg.seed + 1)
     tic = time.perf_counter()
     try:
         pose = sim.reset(start_pose(maze, cfg.seed))
@@ -347,7 +346,7 @@ def explore(maze: Maze, steps: int, cfg: ExploreConfig, emission=None, progress:
         if cfg.method == "mi" or cfg.learn_map:
             from cogmap.inference.online_slam import OnlineSLAM, SLAMConfig
 
-            model = maze_config(maze.size, maze.map_side, NOISE.rot_std)
+            model = maze_config(maze.size, maze.map_side, ROBOT_NOISE.rot_std)
             sc = SLAMConfig(model=model, seed=cfg.seed, train_every=cfg.train_every, train_iters=cfg.train_iters,
                             freeze_emission=emission is not None)
             slam = OnlineSLAM(pose, sc, steps + cfg.train_every, emission=emission, first_scan=scan)

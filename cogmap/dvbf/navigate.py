@@ -79,7 +79,7 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     ValueError
         If ``pretrain_maze`` is ``maze`` itself.
     """
-    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
+    from cogmap.envs.maze_sim import ROBOT_NOISE
     from cogmap.envs.maze_traversal import traverse
     from cogmap.genmodel.dvbf import DVBFConfig
     from cogmap.inference.online_slam import fit_known_poses
@@ -92,10 +92,10 @@ def learn_model(maze: Maze, steps: int = 2000, iters: int = 3000, seed: int = 0,
     emission = None
     if pretrain_maze is not None:
         first = traverse(make_maze(pretrain_maze, maze.complexity, maze.corridor), pretrain_steps, seed=seed + 1000,
-                         noise=NOISE)
+                         noise=ROBOT_NOISE)
         params, _ = fit_known_poses(first.poses, first.scans, cfg, iters=pretrain_iters, seed=seed)
         emission = params.emission
-    tr = traverse(maze, steps, seed=seed, noise=NOISE)
+    tr = traverse(maze, steps, seed=seed, noise=ROBOT_NOISE)
     params, losses = fit_known_poses(tr.poses, tr.scans, cfg, iters=iters, seed=seed + 1, emission=emission)
     info = {"source": "known-pose mapping", "steps": steps, "iters": iters, "map_side": side, "sigma_e": sigma_e,
             "hidden": hidden, "pretrain_maze": pretrain_maze,

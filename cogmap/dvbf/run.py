@@ -16,8 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from cogmap.envs.maze import make_maze
-from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
-from cogmap.envs.maze_sim import ActuationNoise
+from cogmap.envs.maze_sim import ROBOT_NOISE, ActuationNoise
 from cogmap.envs.maze_traversal import traverse
 from cogmap.genmodel.dvbf import maze_config
 from cogmap.inference.dvbf_files import save_params
@@ -27,7 +26,7 @@ from cogmap.inference.online_slam import SLAMConfig, online_slam, path_integrati
 def slam_run(maze_seed: int, steps: int, out: Path, seed: int = 0, progress: bool = True,
              complexity: str = "moderate", corridor: str = "medium", pretrain_maze: int | None = 0,
              pretrain_steps: int = 2000, pretrain_iters: int = 1500, offline: bool = False,
-             noise: ActuationNoise = NOISE, **overrides) -> dict:
+             noise: ActuationNoise = ROBOT_NOISE, **overrides) -> dict:
     """Run online SLAM (or, with ``offline``, offline SLAM: :mod:`cogmap.inference.offline_slam`) on maze
     ``maze_seed`` for ``steps`` steps and write the run directory to ``out``.
 
@@ -211,7 +210,7 @@ def explore_run(maze_seed: int, out: Path, steps: int | None = None, seed: int =
     overrides = {"mi": STUDY_MI, **overrides}
     cfgs = {m: method_config(m, seed=seed, **overrides) for m in methods}
     write_manifest(out, command="dvbf explore", maze_seed=maze_seed, complexity=complexity, corridor=corridor,
-                   steps=steps, seed=seed, noise=asdict(NOISE), configs={m: c.to_json() for m, c in cfgs.items()})
+                   steps=steps, seed=seed, noise=asdict(ROBOT_NOISE), configs={m: c.to_json() for m, c in cfgs.items()})
     needs_model = any(c.method == "mi" or c.learn_map for c in cfgs.values())
     emission = pretrained_emission(cache_dir or cache_dir_default()) if needs_model else None
     results, metrics = {}, {"maze_seed": maze_seed, "complexity": complexity, "corridor": corridor, "steps": steps,

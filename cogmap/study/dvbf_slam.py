@@ -67,7 +67,7 @@ def _maze_seed(env: str) -> int:
 
 
 def dvbf_slam_specs(plan: dict) -> list[dict]:
-    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
+    from cogmap.envs.maze_sim import ROBOT_NOISE
     from cogmap.inference.grid_mcl import MCLConfig
     from cogmap.inference.offline_slam import OfflineConfig
     from cogmap.inference.online_slam import SLAMConfig
@@ -78,13 +78,13 @@ def dvbf_slam_specs(plan: dict) -> list[dict]:
     offline = OFFLINE_TINY if plan["scale"] == "tiny" else OFFLINE
     options = {"online": {"slam": SLAMConfig(**plan["params"]["overrides"]).to_json()},
                "offline": {"offline": OfflineConfig(**offline).to_json()},
-               "mcl": {"mcl": MCLConfig(rot_std=NOISE.rot_std, trans_frac=NOISE.trans_frac).to_json()}}
+               "mcl": {"mcl": MCLConfig(rot_std=ROBOT_NOISE.rot_std, trans_frac=ROBOT_NOISE.trans_frac).to_json()}}
     specs = []
     for env in plan["envs"]:
         for method in plan["methods"]:
             for seed in plan["seeds"]:
                 spec = {"study": NAME, "scale": plan["scale"], "env": env, "method": method, "seed": int(seed),
-                        "noise": {"rot_std": NOISE.rot_std, "trans_frac": NOISE.trans_frac},
+                        "noise": {"rot_std": ROBOT_NOISE.rot_std, "trans_frac": ROBOT_NOISE.trans_frac},
                         "steps": plan["steps"][env], "stop_rule": plan["stop_rule"], "coverage_level": None,
                         "success_rule": None, "method_options": options[method], "params": plan["params"]}
                 specs.append({"key": f"{env}__{method}__s{seed}__{spec_digest(spec)}", **spec})
@@ -131,15 +131,14 @@ def _run_mcl(spec: dict) -> dict:
     import time
 
     from cogmap.envs.maze import make_maze
-    from cogmap.envs.maze_sim import LIDAR_RANGE
-    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
+    from cogmap.envs.maze_sim import LIDAR_RANGE, ROBOT_NOISE
     from cogmap.envs.maze_traversal import traverse
     from cogmap.inference.grid_mcl import MCLConfig, mcl_localise
     from cogmap.inference.online_slam import path_integration
 
     tic = time.perf_counter()
     maze = make_maze(_maze_seed(spec["env"]), "moderate", "medium")  # slam_run's defaults
-    tr = traverse(maze, spec["steps"], seed=spec["seed"], noise=NOISE)
+    tr = traverse(maze, spec["steps"], seed=spec["seed"], noise=ROBOT_NOISE)
     cfg = MCLConfig(**{**spec["method_options"]["mcl"], "seed": spec["seed"]})
     means, _, _ = mcl_localise(maze.occupancy(cfg.resolution), maze.size, tr.poses[0], tr.controls, tr.scans, cfg,
                                LIDAR_RANGE)

@@ -53,11 +53,11 @@ def test_bad_input_is_refused():
 
 
 def test_mcl_on_the_true_map_beats_path_integration_on_a_traversal():
-    from cogmap.envs.maze_sim import ROBOT_NOISE as NOISE
+    from cogmap.envs.maze_sim import ROBOT_NOISE
     from cogmap.inference.online_slam import path_integration
 
     maze = make_maze(2)
-    tr = traverse(maze, 600, seed=3, noise=NOISE)
+    tr = traverse(maze, 600, seed=3, noise=ROBOT_NOISE)
     means, stds, parts = mcl_localise(maze.occupancy(200), maze.size, tr.poses[0], tr.controls, tr.scans,
                                       MCLConfig(n_particles=200, seed=1), LIDAR_RANGE)
     err = np.hypot(*(means[:, :2] - tr.poses[:, :2]).T)
