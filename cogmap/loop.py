@@ -121,6 +121,9 @@ class StepInfo(NamedTuple):
         ``(P, T, F)`` int policies of ``q_pi`` and ``G`` (enumeration).
     free_energy : float
         Variational free energy (nats) of this step's inference.
+    action_probs : numpy.ndarray or None
+        Shaped ``num_controls``: the probability of each control combination, the marginal of
+        ``q_pi`` over the first step (what a sampling agent draws from); None with MCTS.
     """
     qs: list  # posterior per factor
     action: tuple  # control per factor to apply now
@@ -128,6 +131,7 @@ class StepInfo(NamedTuple):
     G: np.ndarray  # expected free energy per policy (enumeration) or per root action (MCTS)
     policies: np.ndarray | None  # (P, T, F) policies of q_pi and G (enumeration)
     free_energy: float  # variational free energy of this step's inference
+    action_probs: np.ndarray | None = None  # probability of each first-step control combination
 
 
 def init(
@@ -145,8 +149,9 @@ def init(
     lr_B: float = 1.0,
     sample: bool = True,
     seed: int = 0,
+    backend: str = "numpy",
     **scheme_options,
-) -> LoopState:
+):
     """A fresh agent on ``model``; the prior is ``D``.
 
     Parameters
@@ -178,12 +183,17 @@ def init(
         Sample actions from the policy posterior (default) instead of taking its mode.
     seed : int, optional
         Seed of the agent's generator, default 0.
+    backend : str, optional
+        ``"numpy"`` (default: every scheme, planner and model, sparse growing maps included) or
+        ``"jax"``: the jitted step of :mod:`cogmap.jax_agent` (dense models, the enumerate
+        planner, the schemes and EFE terms it has), returned as a :class:`JaxLoop` that
+        :func:`step` runs the same way.
     **scheme_options
         Passed to the inference scheme (e.g. ``num_iter=16``).
 
     Returns
     -------
-    LoopState
+    LoopState or JaxLoop
 
     Raises
     ------
@@ -216,10 +226,60 @@ def init(
         raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")
     if learn_B and any(model.B[f].counts is None or model.is_sparse(f) for f in range(len(model.factors))):
         raise SpecError("learn_B needs dense transitions with Dirichlet counts (pB) for every factor")
+    if backend == "jax":
+        return _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_A, learn_B, lr_A,
+                         lr_B, sample, seed, scheme_options)
+    if backend != "numpy":
+        raise ValueError(f"unknown backend {backend!r} (known: numpy, jax)")
     cfg = LoopConfig(scheme, planner, int(policy_len), float(gamma), objective or efe.pymdp_like(), mcts,
                      learn_A, learn_B, lr_A, lr_B, sample, scheme_options or None)
     prior = [model.live_D(f).copy() for f in range(len(model.factors))]
     return LoopState(model, cfg, prior, None, None, np.random.default_rng(seed), 0)
+
+
+class JaxLoop(NamedTuple):
+    """An agent of :func:`init` with ``backend="jax"``: :func:`step` runs its jitted step.
+
+    Attributes
+    ----------
+    model : Model
+        The model it was built from (not changed: learning happens in ``state.params``).
+    agent : cogmap.jax_agent.Agent
+        The static config and the parameters.
+    state : cogmap.jax_agent.AgentState
+        The pure state.
+    """
+    model: Model
+    agent: object
+    state: object
+
+
+def _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_A, learn_B, lr_A, lr_B, sample,
+              seed, scheme_options) -> JaxLoop:
+    import jax
+
+    from cogmap import jax_agent
+
+    if planner != "enumerate" or mcts is not None:
+        raise ValueError(f"the jax backend plans by enumeration only (planner 'enumerate'), got {planner!r}")
+    agent = jax_agent.build(model, scheme=scheme, policy_len=int(policy_len), gamma=gamma, objective=objective,
+                            learn_A=learn_A, learn_B=learn_B, lr_A=lr_A, lr_B=lr_B, sample=sample,
+                            **(scheme_options or {}))
+    return JaxLoop(model, agent, agent.init(jax.random.key(seed)))
+
+
+def _jax_step(loop_state: JaxLoop, observation, action):
+    from cogmap import jax_agent
+
+    model, agent = loop_state.model, loop_state.agent
+    obs = jax_agent.observation(agent.config.layout, _observation(model, observation))
+    given = None if action is None else np.asarray(_given_action(model, action), dtype=np.int32)
+    state, info = jax_agent.jitted_step(agent.config, loop_state.state, obs, given)
+    n = model.num_states
+    qs = [np.asarray(q)[: n[f]] for f, q in enumerate(info.qs)]
+    out = StepInfo(qs, tuple(int(a) for a in np.asarray(info.action)), np.asarray(info.q_pi), np.asarray(info.G),
+                   np.asarray(agent.config.policies), float(info.free_energy), np.asarray(info.action_probs))
+    return loop_state._replace(state=state), out
 
 
 def _observation(model: Model, observation) -> list:
@@ -235,16 +295,53 @@ def _observation(model: Model, observation) -> list:
     return list(observation)
 
 
-def step(state: LoopState, observation) -> tuple[LoopState, StepInfo]:
+def action_probabilities(q_pi: np.ndarray, policies: np.ndarray, num_controls) -> np.ndarray:
+    """Probability of each first-step control combination under ``q_pi``, shaped ``num_controls``.
+
+    Parameters
+    ----------
+    q_pi : numpy.ndarray
+        ``(P,)`` float policy posterior.
+    policies : numpy.ndarray
+        ``(P, T, F)`` int policies.
+    num_controls : sequence of int
+        Controls per factor.
+
+    Returns
+    -------
+    numpy.ndarray
+        Float, sums to 1.
+    """
+    shape = tuple(int(u) for u in num_controls)
+    idx = np.ravel_multi_index(tuple(policies[:, 0, f] for f in range(len(shape))), shape)
+    return np.bincount(idx, weights=q_pi, minlength=int(np.prod(shape))).reshape(shape)
+
+
+def _given_action(model: Model, action) -> tuple:
+    acts = (action,) if np.ndim(action) == 0 else tuple(action)
+    ok = len(acts) == len(model.factors) and all(
+        isinstance(a, int | np.integer) and not isinstance(a, bool | np.bool_) and 0 <= a < u
+        for a, u in zip(acts, model.num_controls, strict=False))
+    if not ok:
+        raise ValueError(f"action must be one integer control per factor, within {list(model.num_controls)}; "
+                         f"got {action!r}")
+    return tuple(int(a) for a in acts)
+
+
+def step(state, observation, action=None):
     """Infer, learn, plan and act for one observation.
 
     Parameters
     ----------
-    state : LoopState
-        The agent's state.
+    state : LoopState or JaxLoop
+        The agent's state (a :class:`JaxLoop` from ``init(..., backend="jax")``).
     observation : sequence or dict or int
         One entry per modality (an outcome index, a distribution over outcomes or None), a dict by
         modality name, or a bare index for a single modality.
+    action : tuple of int or int, optional
+        Controls (one per factor) to apply in place of the agent's own choice, for example a
+        subject's recorded choice: the step still evaluates its policies and reports
+        ``action_probs``, then learns and predicts with this action.
 
     Returns
     -------
@@ -255,10 +352,14 @@ def step(state: LoopState, observation) -> tuple[LoopState, StepInfo]:
     Raises
     ------
     ValueError
-        If the observation does not have one entry per modality.
+        If the observation does not have one entry per modality, or ``action`` is not one
+        control per factor in range.
     """
+    if isinstance(state, JaxLoop):
+        return _jax_step(state, observation, action)
     model, cfg = state.model, state.config
     obs = _observation(model, observation)
+    given = None if action is None else _given_action(model, action)
     qs, info = inference.get(cfg.scheme)(model, state.prior, [obs], **(cfg.scheme_options or {}))
     qs = [np.asarray(q, dtype=float) for q in qs]
     if cfg.learn_A:
@@ -274,7 +375,9 @@ def step(state: LoopState, observation) -> tuple[LoopState, StepInfo]:
     if len(action) != len(model.factors):
         raise ValueError(f"planner '{cfg.planner}' returned {len(action)} control(s), the model has "
                          f"{len(model.factors)} factor(s)")
+    action = given or action
     q_pi, G, policies = plan.q_pi, np.asarray(plan.G), plan.policies
+    probs = None if q_pi is None or policies is None else action_probabilities(q_pi, policies, model.num_controls)
     prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
     nxt = state._replace(prior=prior, qs=qs, action=action, t=state.t + 1)
-    return nxt, StepInfo(qs, action, q_pi, G, policies, float(info.free_energy))
+    return nxt, StepInfo(qs, action, q_pi, G, policies, float(info.free_energy), probs)
