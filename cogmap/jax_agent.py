@@ -401,6 +401,62 @@ def step(config: JaxConfig, state: AgentState, obs, action=None) -> tuple[AgentS
     return nxt, StepInfo(qs, action, q_pi, G, probs, F)
 
 
+class Trajectory(NamedTuple):
+    """One episode of :func:`rollout` (arrays with a leading time axis).
+
+    Attributes
+    ----------
+    obs : tuple of jax.Array
+        Per modality ``(T, obs_capacity[m])`` observation vectors the agent received.
+    actions : jax.Array
+        ``(T, F)`` int controls it applied.
+    info : StepInfo
+        Its step reports, stacked over time.
+    state : AgentState
+        Its state after the last step.
+    """
+
+    obs: tuple
+    actions: jax.Array
+    info: StepInfo
+    state: AgentState
+
+
+def rollout(agent: Agent, world, key, steps: int, params: AgentParams | None = None) -> Trajectory:
+    """A whole episode of ``agent`` against a pure JAX ``world`` as one ``lax.scan`` (jit and vmap it).
+
+    Parameters
+    ----------
+    agent : Agent
+    world : cogmap.envs.jax_worlds.World
+        The generative process (:mod:`cogmap.envs.jax_worlds`).
+    key : jax.Array
+        Random key of the episode (world and action sampling).
+    steps : int
+        Observations (one action after each).
+    params : AgentParams, optional
+        Parameters to act with (default the agent's).
+
+    Returns
+    -------
+    Trajectory
+    """
+    from cogmap.envs import jax_worlds
+
+    k_agent, k_world, k_steps = jax.random.split(key, 3)
+    state = agent.init(k_agent, params)
+    world_state, obs = jax_worlds.reset(world, k_world)
+
+    def body(carry, k):
+        state, world_state, obs = carry
+        state, info = agent.step(state, obs)
+        world_state, nxt = jax_worlds.step(world, world_state, info.action, k)
+        return (state, world_state, nxt), (obs, info)
+
+    (state, _, _), (seen, infos) = jax.lax.scan(body, (state, world_state, obs), jax.random.split(k_steps, steps))
+    return Trajectory(seen, infos.action, infos, state)
+
+
 #: ``in_axes``/``out_axes`` of a population sharing one model: parameters and their prepared
 #: quantities unbatched, everything else batched (an agent that learns needs its own copy: batch all)
 SHARED = AgentState(None, 0, 0, 0, 0, 0, None)
@@ -440,4 +496,4 @@ jitted_step = jax.jit(step, static_argnums=0)
 
 
 __all__ = ["SHARED", "Agent", "AgentParams", "AgentState", "JaxConfig", "StepInfo", "build", "init", "jitted_step",
-           "learn_A", "learn_B", "observation", "population", "step"]
+           "learn_A", "learn_B", "observation", "population", "rollout", "step", "Trajectory"]

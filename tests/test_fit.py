@@ -1,0 +1,127 @@
+"""Fitting agents to behaviour: the likelihood of choices, its gradients, episodes as one scan, MAP recovery."""
+
+from __future__ import annotations
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from cogmap import fit, jax_agent, loop
+from cogmap.envs import jax_worlds
+from cogmap.genmodel import Factor, Modality, ModelSpec, compile
+
+
+@pytest.fixture(autouse=True)
+def x64():
+    with jax.enable_x64(True):
+        yield
+
+
+def _learning_tmaze():
+    """The T-maze with Dirichlet counts on every likelihood (an agent that learns A)."""
+    base = jax_worlds.tmaze_model()
+    spec = ModelSpec(
+        factors=[Factor("location", 4, num_controls=4), Factor("context", 2)],
+        modalities=[Modality("where", 4, ("location",)), Modality("reward", 3, ("location", "context")),
+                    Modality("cue", 2, ("location", "context"))],
+        A={"where": base.live_A(0), "reward": base.live_A(1), "cue": base.live_A(2)},
+        B={"location": base.live_B(0), "context": base.live_B(1)},
+        C={"reward": base.live_C(1)},
+        D={"location": base.live_D(0)},
+        pA={"where": 8 * base.live_A(0) + 0.5, "reward": 2 * base.live_A(1) + 0.5, "cue": 2 * base.live_A(2) + 0.5},
+    )
+    return compile(spec)
+
+
+def test_the_likelihood_is_the_sum_of_the_numpy_loops_action_log_probabilities():
+    model = jax_worlds.tmaze_model()
+    agent = jax_agent.build(model, policy_len=2, gamma=3.0)
+    data = fit.simulate(agent, jax_worlds.tmaze_world(), jax.random.key(4), trials=3, steps=2)
+    total = 0.0
+    for k in range(3):
+        state = loop.init(jax_worlds.tmaze_model(), policy_len=2, gamma=3.0)
+        for t in range(2):
+            obs = [int(np.argmax(np.asarray(o[k, t]))) for o in data.obs]
+            choice = tuple(int(a) for a in np.asarray(data.actions[k, t]))
+            state, info = loop.step(state, obs, action=choice)
+            total += np.log(info.action_probs[choice])
+    assert abs(float(fit.log_likelihood(agent, data)) - total) < 1e-10
+
+
+def test_gradients_match_central_finite_differences():
+    agent = jax_agent.build(_learning_tmaze(), policy_len=2, gamma=2.0, learn_A=True, lr_A=0.8,
+                            objective=fit_objective())
+    data = fit.simulate(agent, jax_worlds.tmaze_world(), jax.random.key(7), trials=4, steps=2)
+    free = fit.check_free([fit.Free("gamma"), fit.Free("C:1", fit.Normal(1.0, 1.0)), fit.Free("lr_A"),
+                           fit.Free("pA:1"), fit.Free("w:state_info_gain", fit.Normal(1.0, 1.0))], agent)
+    theta = fit.unconstrained(free, jnp.array([2.0, 1.2, 0.8, 1.5, 0.9]))
+
+    def ll(th):
+        return fit.log_likelihood(agent, data, fit.apply(agent.params, free, th))
+
+    g = np.asarray(jax.grad(ll)(theta))
+    h = 1e-5
+    for i in range(len(free)):
+        e = jnp.zeros_like(theta).at[i].set(h)
+        fd = (float(ll(theta + e)) - float(ll(theta - e))) / (2 * h)
+        assert abs(g[i] - fd) <= 1e-6 * max(abs(fd), 1e-3), (free[i].name, g[i], fd)
+    assert np.all(np.abs(g) > 1e-4), "every parameter moves the likelihood"
+
+
+def fit_objective():
+    from cogmap.planning import efe
+
+    return efe.objective([(efe.observation_preference, 1.0), (efe.state_info_gain, 1.0), (efe.a_novelty, 1.0)])
+
+
+def test_an_episode_is_one_scan_and_agrees_with_stepping_by_hand():
+    agent = jax_agent.build(jax_worlds.tmaze_model(), policy_len=2, gamma=4.0)
+    world = jax_worlds.tmaze_world()
+    tr = jax.jit(lambda k: jax_agent.rollout(agent, world, k, 3))(jax.random.key(2))
+    state = agent.init(jax.random.split(jax.random.key(2), 3)[0])
+    for t in range(3):
+        state, info = agent.step(state, tuple(o[t] for o in tr.obs))
+        assert np.array_equal(np.asarray(info.action), np.asarray(tr.actions[t]))
+        np.testing.assert_allclose(np.asarray(info.q_pi), np.asarray(tr.info.q_pi[t]), atol=1e-12)
+    # the world follows B: the location after each move is the move's target (B is 90 % right)
+    where = np.asarray(tr.obs[0]).argmax(axis=1)
+    assert where[0] == 0, "every episode starts at the centre"
+
+
+def test_map_recovers_the_policy_precision_of_simulated_subjects():
+    agent = jax_agent.build(jax_worlds.tmaze_model(), policy_len=2, gamma=2.0)
+    free = [fit.Free("gamma", fit.LogNormal(np.log(2.0), 0.6))]
+    true = np.exp(np.random.default_rng(0).normal(np.log(2.0), 0.5, 12))
+
+    def sim(g, k):
+        return fit.simulate(agent, jax_worlds.tmaze_world(), k, trials=60, steps=2,
+                            params=fit.apply(agent.params, free, jnp.log(g)[None]))
+
+    data = jax.jit(jax.vmap(sim))(jnp.asarray(true), jax.random.split(jax.random.key(1), 12))
+    res = fit.fit_map(agent, free, data, iterations=150)
+    est = res.values[:, 0]
+    assert np.corrcoef(est, true)[0, 1] > 0.85
+    assert np.median(np.abs(est - true) / true) < 0.2
+    assert np.all(res.trace[-1] < res.trace[0])
+    for i in range(2):  # the estimate is a stationary point of the log posterior
+        subject = jax.tree_util.tree_map(lambda x, i=i: x[i], data)
+        g = jax.grad(lambda th, s=subject: fit.log_posterior(agent, free, th, s))(jnp.asarray(res.theta[i]))
+        assert np.all(np.abs(np.asarray(g)) < 1e-2)
+
+
+def test_bad_free_parameters_are_refused():
+    agent = jax_agent.build(jax_worlds.tmaze_model())
+    with pytest.raises(ValueError, match="unknown free parameter"):
+        fit.check_free([fit.Free("beta")], agent)
+    with pytest.raises(ValueError, match="3 modalities"):
+        fit.check_free([fit.Free("C:5", fit.Normal())], agent)
+    with pytest.raises(ValueError, match="no Dirichlet counts"):
+        fit.check_free([fit.Free("pA:0")], agent)
+    with pytest.raises(ValueError, match="needs a LogNormal prior"):
+        fit.check_free([fit.Free("gamma", fit.Normal())], agent)
+    with pytest.raises(ValueError, match="repeat"):
+        fit.check_free([fit.Free("gamma"), fit.Free("gamma")], agent)
+    data = fit.simulate(agent, jax_worlds.tmaze_world(), jax.random.key(0), trials=2, steps=2)
+    with pytest.raises(ValueError, match="subjects stacked"):
+        fit.fit_map(agent, [fit.Free("gamma")], data)
