@@ -31,6 +31,7 @@ API = {
     "baselines": ("cogmap.baselines", "cogmap.baselines", "cogmap/baselines"),
     "drone": ("cogmap.drone", "cogmap.drone", "cogmap/drone"),
     "dvbf": ("cogmap.dvbf", "cogmap.dvbf", "cogmap/dvbf"),
+    "fit": ("cogmap.fit", "cogmap.fit", "cogmap/fit"),
     "study": ("cogmap.study", "cogmap.study", "cogmap/study"),
 }
 

@@ -302,7 +302,7 @@ def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter
 
     start = tuple(jnp.broadcast_to(lv / jnp.sum(lv), (T, lv.shape[0])).astype(prior[0].dtype)
                   for lv in (jnp.asarray(x, dtype=prior[0].dtype) for x in arrays.live))
-    qs = jax.lax.fori_loop(0, num_iter, sweep, start)
+    qs = jax.lax.fori_loop(0, num_iter, sweep, start, unroll=True)
     return qs, window_terms(layout, prior, qs, lls, logB)
 
 

@@ -125,3 +125,65 @@ def test_bad_free_parameters_are_refused():
     data = fit.simulate(agent, jax_worlds.tmaze_world(), jax.random.key(0), trials=2, steps=2)
     with pytest.raises(ValueError, match="subjects stacked"):
         fit.fit_map(agent, [fit.Free("gamma")], data)
+
+
+def test_diagnostics_on_chains_with_known_answers():
+    from cogmap.inference.mcmc_diagnostics import effective_sample_size, split_rhat
+
+    rng = np.random.default_rng(0)
+    iid = rng.normal(size=(4, 2000))
+    assert abs(float(split_rhat(iid)) - 1.0) < 0.01
+    assert abs(float(effective_sample_size(iid)) / 8000 - 1.0) < 0.1
+    rho, x = 0.8, np.zeros((4, 4000))
+    for t in range(1, 4000):
+        x[:, t] = rho * x[:, t - 1] + rng.normal(size=4)
+    ess = float(effective_sample_size(x))
+    assert abs(ess / (16000 * (1 - rho) / (1 + rho)) - 1.0) < 0.25  # the AR(1) closed form
+    apart = iid + np.array([0.0, 0.0, 0.0, 3.0])[:, None]
+    assert float(split_rhat(apart)) > 1.5
+    with pytest.raises(ValueError, match="at least 4 samples"):
+        split_rhat(np.zeros((2, 3)))
+
+
+def _grid_posterior(agent, free, subject, lo=-3.0, hi=4.0, n=701):
+    """Log posterior of one scalar parameter on a grid of the unconstrained scale (quadrature reference)."""
+    th = np.linspace(lo, hi, n)
+    lp = np.asarray(jax.vmap(lambda t: fit.log_posterior(agent, free, t[None], subject))(jnp.asarray(th)))
+    return th, lp
+
+
+def test_nuts_and_laplace_agree_with_quadrature_of_the_posterior():
+    agent = jax_agent.build(jax_worlds.tmaze_model(), policy_len=2, gamma=2.0)
+    free = (fit.Free("gamma", fit.LogNormal(np.log(2.0), 0.6)),)
+    data = fit.simulate_subjects(fit.Candidate("efe", agent, free), jax_worlds.tmaze_world(), jax.random.key(5),
+                                 np.array([[2.5]]), trials=20, steps=2)
+    post = fit.fit_nuts(agent, free, data, jax.random.key(6), chains=2, warmup=150, samples=200)
+    evidence = fit.laplace_evidence(agent, free, data, iterations=200)
+    for i in range(1):
+        subject = jax.tree_util.tree_map(lambda x, i=i: x[i], data)
+        th, lp = _grid_posterior(agent, free, subject)
+        w = np.exp(lp - lp.max())
+        step = th[1] - th[0]
+        exact_mean = float((np.exp(th) * w).sum() / w.sum())
+        log_z = float(lp.max() + np.log(w.sum() * step))
+        se = post.sd[i, 0] / np.sqrt(post.ess[i, 0])
+        assert abs(post.mean[i, 0] - exact_mean) < 4 * se + 1e-3, (post.mean[i, 0], exact_mean, se)
+        assert post.rhat[i, 0] < 1.05
+        assert abs(evidence[i] - log_z) < 0.2, (evidence[i], log_z)
+
+
+def test_model_comparison_recovers_the_generating_agent():
+    from cogmap.planning import efe
+
+    free = (fit.Free("gamma", fit.LogNormal(np.log(2.0), 0.6)),)
+    m = jax_worlds.tmaze_model
+    utility = efe.objective([(efe.observation_preference, 1.0)])
+    cands = [fit.Candidate("efe", jax_agent.build(m(), policy_len=2, gamma=2.0), free),
+             fit.Candidate("utility only", jax_agent.build(m(), policy_len=2, gamma=2.0, objective=utility), free)]
+    M = fit.confusion(cands, jax_worlds.tmaze_world(), jax.random.key(0),
+                      lambda i, rng: np.exp(rng.normal(np.log(2.0), 0.4, (4, 1))), subjects=4, trials=30, steps=2,
+                      iterations=100)
+    assert M.shape == (2, 2) and np.allclose(M.sum(axis=1), 1.0)
+    assert np.all(np.diag(M) >= 3 / 4), M
+    with pytest.raises(ValueError, match="at least two candidates"):
+        fit.compare(cands[:1], None)

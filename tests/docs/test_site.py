@@ -17,8 +17,10 @@ pytest.importorskip("mkdocs", reason="the docs extra (pip install -e .[docs]) is
 ROOT = Path(__file__).resolve().parents[2]
 # packages whose exported names (``__all__``) the API reference must show
 PACKAGES = ("cogmap.genmodel", "cogmap.inference", "cogmap.planning", "cogmap.envs", "cogmap.baselines",
-            "cogmap.drone", "cogmap.study")
-MODULES = ("cogmap.loop", "cogmap.harness")  # agent-layer modules without ``__all__``: their public callables
+            "cogmap.drone", "cogmap.study",
+            "cogmap.fit")
+# agent-layer modules whose public callables the reference must show
+MODULES = ("cogmap.loop", "cogmap.harness", "cogmap.jax_agent")
 
 
 def _mkdocs(*args: str, cwd: Path) -> subprocess.CompletedProcess:

@@ -1,4 +1,4 @@
-"""Fit agents to behaviour: the likelihood of observed choices, free parameters with priors, MAP estimates.
+"""The likelihood of observed choices under an agent, and free parameters with priors.
 
     agent = jax_agent.build(tmaze_model(), policy_len=2, gamma=4.0)
     free = [fit.Free("gamma", prior=fit.LogNormal(1.0, 0.5))]
@@ -29,7 +29,6 @@ from typing import NamedTuple
 
 import jax
 import jax.numpy as jnp
-import numpy as np
 
 from cogmap.jax_agent import Agent, AgentParams
 from cogmap.jax_agent import rollout as _rollout
@@ -247,91 +246,10 @@ def simulate(agent: Agent, world, key, trials: int, steps: int, params: AgentPar
     return Behaviour(obs, actions)
 
 
-class MAPResult(NamedTuple):
-    """Maximum a posteriori estimates (one row per subject).
-
-    Attributes
-    ----------
-    names : tuple of str
-        Free parameter names, in column order.
-    values : numpy.ndarray
-        ``(N, k)`` float estimates on the natural scale.
-    theta : numpy.ndarray
-        ``(N, k)`` float estimates on the unconstrained scale.
-    log_posterior : numpy.ndarray
-        ``(N,)`` float ``log p(choices | theta) + log p(theta)`` at the estimate.
-    trace : numpy.ndarray
-        ``(iterations, N)`` float negative log posterior per iteration (convergence).
-    """
-
-    names: tuple
-    values: np.ndarray
-    theta: np.ndarray
-    log_posterior: np.ndarray
-    trace: np.ndarray
-
-
 def log_posterior(agent: Agent, free, theta, data: Behaviour):
     """``log p(choices | theta) + log p(theta)`` of one subject (unnormalised)."""
     return log_likelihood(agent, data, apply(agent.params, free, theta)) + log_prior(free, theta)
 
 
-def fit_map(agent: Agent, free, data: Behaviour, *, iterations: int = 300, learning_rate: float = 0.05,
-            init=None) -> MAPResult:
-    """MAP estimates of the free parameters for every subject at once (Adam, from optax).
-
-    Parameters
-    ----------
-    agent : Agent
-    free : sequence of Free
-    data : Behaviour
-        Subjects stacked on a leading axis (``actions`` shaped ``(N, K, T, F)``).
-    iterations : int, optional
-        Adam steps, default 300.
-    learning_rate : float, optional
-        Adam step size on the unconstrained scale, default 0.05.
-    init : array_like, optional
-        ``(k,)`` starting values on the natural scale; default the priors' centres.
-
-    Returns
-    -------
-    MAPResult
-
-    Raises
-    ------
-    ValueError
-        For bad free parameters (:func:`check_free`), data without a subject axis, or
-        ``iterations < 1``.
-    """
-    import optax
-
-    free = check_free(free, agent)
-    if np.ndim(data.actions) != 4:
-        raise ValueError(f"fit_map needs subjects stacked: actions shaped (N, trials, steps, factors), "
-                         f"got {np.shape(data.actions)}")
-    if iterations < 1:
-        raise ValueError(f"iterations must be >= 1, got {iterations}")
-    start = (jnp.stack([f.prior[0] for f in free]) if init is None else unconstrained(free, init))
-    start = start.astype(agent.params.gamma.dtype)
-    opt = optax.adam(learning_rate)
-
-    def one(subject):
-        loss = lambda th: -log_posterior(agent, free, th, subject)  # noqa: E731
-        grad = jax.value_and_grad(loss)
-
-        def body(carry, _):
-            th, st = carry
-            value, g = grad(th)
-            upd, st = opt.update(g, st, th)
-            return (optax.apply_updates(th, upd), st), value
-
-        (th, _), trace = jax.lax.scan(body, (start, opt.init(start)), None, length=iterations)
-        return th, -loss(th), trace
-
-    theta, lp, trace = jax.jit(jax.vmap(one))(data)
-    return MAPResult(tuple(f.name for f in free), np.asarray(values(free, theta.T).T), np.asarray(theta),
-                     np.asarray(lp), np.asarray(trace).T)
-
-
-__all__ = ["Behaviour", "Free", "LogNormal", "MAPResult", "Normal", "apply", "check_free", "fit_map",
-           "log_likelihood", "log_posterior", "log_prior", "simulate", "unconstrained", "values"]
+__all__ = ["Behaviour", "Free", "LogNormal", "Normal", "apply", "check_free", "log_likelihood", "log_posterior",
+           "log_prior", "simulate", "unconstrained", "values"]
