@@ -79,3 +79,15 @@ def wrap_angle(a):
     if type(a).__module__.split(".")[0] not in ("jax", "jaxlib"):
         a = np.asarray(a, dtype=float)
     return (a + np.pi) % (2 * np.pi) - np.pi
+
+
+def floor_log_jax(x):
+    """:func:`floor_log` for JAX arrays (traced too): ``ln max(x, eps)``."""
+    import jax.numpy as jnp
+
+    return jnp.log(jnp.maximum(x, LOG_FLOOR))
+
+
+def xlogx_jax(x):
+    """:func:`xlogx` for JAX arrays (traced too): ``x ln max(x, eps)``."""
+    return x * floor_log_jax(x)

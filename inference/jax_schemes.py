@@ -27,6 +27,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from cogmap.genmodel.numerics import LOG_FLOOR
+from cogmap.genmodel.numerics import floor_log_jax as floor_log
 
 
 class Evidence(NamedTuple):
@@ -42,11 +43,6 @@ class Evidence(NamedTuple):
 
     lik: tuple
     present: jax.Array
-
-
-def floor_log(x):
-    """``ln max(x, eps)``, the floor of the numpy schemes."""
-    return jnp.log(jnp.maximum(x, LOG_FLOOR))
 
 
 def xlogx_sum(q):

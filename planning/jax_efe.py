@@ -19,6 +19,7 @@ import numpy as np
 from jax.scipy.special import digamma
 
 from cogmap.genmodel.numerics import LOG_FLOOR
+from cogmap.genmodel.numerics import xlogx_jax as xlogx
 
 from . import efe as np_efe
 from .inductive import UNREACHABLE
@@ -129,11 +130,6 @@ class Prepared(NamedTuple):
     HA: tuple
     wA: tuple
     wB: tuple
-
-
-def xlogx(x):
-    """``x ln max(x, eps)`` (numpy's ``xlogx``)."""
-    return x * jnp.log(jnp.maximum(x, LOG_FLOOR))
 
 
 def novelty_weights(counts):
