@@ -29,35 +29,11 @@ import jax.numpy as jnp  # noqa: E402
 import numpy as np  # noqa: E402
 
 from cogmap import jax_agent  # noqa: E402
-from cogmap.genmodel import Factor, Modality, ModelSpec, compile  # noqa: E402
-from cogmap.genmodel.demo_models import tmaze  # noqa: E402
+from cogmap.envs.jax_worlds import grid_model, tmaze_model  # noqa: E402
 from cogmap.inference import to_pymdp  # noqa: E402
 
 BATCHES = (1, 64, 1024, 4096)
 WARM = 2  # calls counted as compilation (pymdp compiles its first two calls apart)
-
-
-def tmaze_model():
-    """The T-maze of ``cogmap compare-inference`` with a preference for reward."""
-    m = tmaze()
-    m.C[1][:3] = [0.0, 3.0, -6.0]
-    return m
-
-
-def grid_model(side: int = 10):
-    """A ``side x side`` open grid (stay + 4 moves, walls keep you in place), a noisy location
-    sensor and a preference for the far corner."""
-    n = side * side
-    B = np.zeros((n, n, 5))
-    for s in range(n):
-        x, y = s % side, s // side
-        for u, (dx, dy) in enumerate(((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1))):
-            B[min(max(y + dy, 0), side - 1) * side + min(max(x + dx, 0), side - 1), s, u] = 1.0
-    A = 0.8 * np.eye(n) + 0.2 / n
-    C = np.zeros(n)
-    C[n - 1] = 4.0
-    return compile(ModelSpec([Factor("cell", n, num_controls=5, stay=0)], [Modality("where", n, ("cell",))],
-                             A={"where": A}, B={"cell": B}, C={"where": C}, D={"cell": np.eye(n)[0]}))
 
 
 def random_inputs(model, batch: int, steps: int, seed: int) -> list:
