@@ -17,7 +17,6 @@ with every agent holding its own copy of the model arrays, as pymdp's batched ``
 from __future__ import annotations
 
 import argparse
-import importlib
 import json
 import time
 
@@ -78,8 +77,7 @@ def run_cogmap(model, batch: int, inputs, shared: bool):
 def run_pymdp(model, batch: int, inputs):
     import equinox as eqx
     from pymdp.agent import Agent
-
-    rollout = importlib.import_module("pymdp.envs.rollout")
+    from pymdp.envs.rollout import infer_and_plan  # the package's name `rollout` is a function
     one = to_pymdp(model, policy_len=1, gamma=16.0, num_iter=16, inference_algo="fpi",
                    action_selection="deterministic")
 
@@ -90,7 +88,7 @@ def run_pymdp(model, batch: int, inputs):
                   B_dependencies=[[f] for f in range(len(model.factors))], num_controls=list(model.num_controls),
                   policy_len=1, gamma=16.0, num_iter=16, inference_algo="fpi", action_selection="deterministic",
                   batch_size=batch)
-    step = eqx.filter_jit(rollout.infer_and_plan)
+    step = eqx.filter_jit(infer_and_plan)
     qs = [jnp.repeat(d, batch, axis=0)[:, None] for d in agent.D]
     key = jax.random.key(0)
     t0 = time.perf_counter()

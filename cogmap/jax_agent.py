@@ -33,7 +33,7 @@ from cogmap.genmodel.jax_model import JaxModel, Layout, to_jax
 from cogmap.inference import jax_schemes as js
 from cogmap.planning import efe
 from cogmap.planning import jax_efe as je
-from cogmap.planning.decide import MODES, make_objective
+from cogmap.planning.decide import check_plan_settings
 from cogmap.planning.policies import enumerate_policies
 
 
@@ -261,16 +261,9 @@ def build(
         raise ValueError(f"unknown scheme {scheme!r} on the JAX backend (known: {', '.join(js.SCHEMES)})")
     if scheme == "filter" and len(model.factors) != 1:
         raise ValueError(f"filter is a single-factor scheme; the model has {len(model.factors)} factors")
-    if not (isinstance(policy_len, int | np.integer) and policy_len >= 1):
-        raise ValueError(f"policy_len must be an integer >= 1, got {policy_len!r}")
     if not (isinstance(num_iter, int | np.integer) and num_iter >= 1):
         raise ValueError(f"num_iter must be an integer >= 1, got {num_iter!r}")
-    if not (np.isfinite(gamma) and gamma > 0):
-        raise ValueError(f"gamma (policy precision) must be positive and finite, got {gamma!r}")
-    if isinstance(objective, str):
-        if objective not in MODES:
-            raise ValueError(f"unknown objective '{objective}' (known: {', '.join(MODES)} or an Objective)")
-        objective = make_objective(objective)
+    objective = check_plan_settings(policy_len, gamma, objective)
     weights = je.weights_of(objective or efe.pymdp_like())
     if learn_A and any(model.A[m].counts is None for m in range(len(model.modalities))):
         raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")

@@ -29,7 +29,7 @@ from cogmap.genmodel import Model, SpecError
 from cogmap.inference.learning import learn_observation
 from cogmap.inference.registry import check_options
 from cogmap.planning import efe
-from cogmap.planning.decide import MODES, make_objective
+from cogmap.planning.decide import check_plan_settings
 from cogmap.planning.mcts import MCTSConfig
 from cogmap.planning.planners import PlanSettings, available_planners, get_planner
 
@@ -214,14 +214,7 @@ def init(
     check_options(scheme, scheme_options)  # and options the scheme does not take, naming them
     if not isinstance(planner, str) or planner not in available_planners():
         raise ValueError(f"unknown planner {planner!r} (known: {', '.join(available_planners())})")
-    if not (isinstance(policy_len, int | np.integer) and policy_len >= 1):
-        raise ValueError(f"policy_len must be an integer >= 1, got {policy_len!r}")
-    if not (np.isfinite(gamma) and gamma > 0):
-        raise ValueError(f"gamma (policy precision) must be positive and finite, got {gamma!r}")
-    if isinstance(objective, str):
-        if objective not in MODES:
-            raise ValueError(f"unknown objective '{objective}' (known: {', '.join(MODES)} or an Objective)")
-        objective = make_objective(objective)
+    objective = check_plan_settings(policy_len, gamma, objective)
     if learn_A and not all(model.has_counts_A(m) for m in range(len(model.modalities))):
         raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")
     if learn_B and any(model.B[f].counts is None or model.is_sparse(f) for f in range(len(model.factors))):

@@ -45,6 +45,38 @@ def make_objective(mode, inductive_weight: float | None = None) -> efe.Objective
     return MODES[mode]()
 
 
+def check_plan_settings(policy_len, gamma, objective):
+    """Check an agent's planning settings; returns the objective (a mode name made an Objective).
+
+    Parameters
+    ----------
+    policy_len : int
+        Steps per enumerated policy, an integer >= 1.
+    gamma : float
+        Policy precision, positive and finite.
+    objective : Objective or str or None
+        An Objective, a name of :data:`MODES`, or None.
+
+    Returns
+    -------
+    Objective or None
+
+    Raises
+    ------
+    ValueError
+        For an invalid ``policy_len`` or ``gamma``, or an unknown objective name.
+    """
+    if not (isinstance(policy_len, int | np.integer) and policy_len >= 1):
+        raise ValueError(f"policy_len must be an integer >= 1, got {policy_len!r}")
+    if not (np.isfinite(gamma) and gamma > 0):
+        raise ValueError(f"gamma (policy precision) must be positive and finite, got {gamma!r}")
+    if isinstance(objective, str):
+        if objective not in MODES:
+            raise ValueError(f"unknown objective '{objective}' (known: {', '.join(MODES)} or an Objective)")
+        objective = make_objective(objective)
+    return objective
+
+
 def decide(
     model,
     qs,
