@@ -90,6 +90,17 @@ def tmaze_model(reward: float = 3.0, punishment: float = -6.0):
     return m
 
 
+def _grid_moves(side: int) -> np.ndarray:
+    """``(n, n, 5)`` transitions of a ``side x side`` grid: stay, +x, -x, +y, -y; walls keep you in place."""
+    n = side * side
+    B = np.zeros((n, n, 5))
+    for s in range(n):
+        x, y = s % side, s // side
+        for u, (dx, dy) in enumerate(((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1))):
+            B[min(max(y + dy, 0), side - 1) * side + min(max(x + dx, 0), side - 1), s, u] = 1.0
+    return B
+
+
 def grid_model(side: int = 10, goal_preference: float = 4.0):
     """A ``side x side`` open grid: stay + 4 moves (walls keep you in place), a location sensor
     that is right 80 % of the time (else any cell), a preference for the far corner, start at 0.
@@ -106,16 +117,48 @@ def grid_model(side: int = 10, goal_preference: float = 4.0):
     Model
     """
     n = side * side
-    B = np.zeros((n, n, 5))
-    for s in range(n):
-        x, y = s % side, s // side
-        for u, (dx, dy) in enumerate(((0, 0), (1, 0), (-1, 0), (0, 1), (0, -1))):
-            B[min(max(y + dy, 0), side - 1) * side + min(max(x + dx, 0), side - 1), s, u] = 1.0
+    B = _grid_moves(side)
     C = np.zeros(n)
     C[n - 1] = goal_preference
     return compile(ModelSpec([Factor("cell", n, num_controls=5, stay=0)], [Modality("where", n, ("cell",))],
                              A={"where": 0.8 * np.eye(n) + 0.2 / n}, B={"cell": B}, C={"where": C},
                              D={"cell": np.eye(n)[0]}))
+
+
+def landmark_grid_model(side: int = 5, goal_preference: float = 3.0, reliability: float = 0.4):
+    """A ``side x side`` grid for fitting studies: the start is unknown within the first column,
+    the location sensor is exact on the middle row (landmarks) and right with probability
+    ``reliability`` elsewhere (else any cell), and the preference grows towards the far corner.
+
+    Every choice then carries information about the agent: a utility-seeker walks down the
+    preference gradient, an information-seeker heads for the landmarks, and the policy
+    precision sets how consistently either does.
+
+    Parameters
+    ----------
+    side : int, optional
+        Cells per side, default 5 (25 states).
+    goal_preference : float, optional
+        Log-preference of the far corner over the start corner, default 3 (linear in the
+        Manhattan distance between).
+    reliability : float, optional
+        Probability that the sensor names the true cell off the landmark row, in (0, 1]; default 0.4.
+
+    Returns
+    -------
+    Model
+    """
+    if not 0.0 < reliability <= 1.0:
+        raise ValueError(f"reliability must be in (0, 1], got {reliability}")
+    n = side * side
+    x, y = np.arange(n) % side, np.arange(n) // side
+    landmark = y == side // 2
+    A = np.where(landmark[None, :], np.eye(n), reliability * np.eye(n) + (1 - reliability) / n)
+    C = goal_preference * (x + y) / (2 * (side - 1))
+    D = np.where(x == 0, 1.0, 0.0)
+    return compile(ModelSpec([Factor("cell", n, num_controls=5, stay=0)], [Modality("where", n, ("cell",))],
+                             A={"where": A}, B={"cell": _grid_moves(side)}, C={"where": C},
+                             D={"cell": D / D.sum()}))
 
 
 def world_of(model) -> World:
@@ -133,4 +176,5 @@ def grid_world(side: int = 10) -> World:
     return world_of(grid_model(side))
 
 
-__all__ = ["World", "grid_model", "grid_world", "observe", "reset", "step", "tmaze_model", "tmaze_world", "world_of"]
+__all__ = ["World", "grid_model", "grid_world", "landmark_grid_model", "observe", "reset", "step", "tmaze_model",
+           "tmaze_world", "world_of"]

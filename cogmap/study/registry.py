@@ -23,7 +23,7 @@ from typing import NamedTuple
 from cogmap.genmodel.contracts import Study
 from cogmap.genmodel.registry import Registry
 
-from . import config, drone, dvbf_exploration, dvbf_navigation, dvbf_slam, report, runs
+from . import config, drone, dvbf_exploration, dvbf_navigation, dvbf_slam, recovery, report, runs
 
 SCALES = ("reduced", "full", "tiny")
 
@@ -191,4 +191,6 @@ register_study("dvbf-exploration", plan=dvbf_exploration.dvbf_exploration_plan,
                report=dvbf_exploration.dvbf_exploration_report)
 register_study("dvbf-slam", plan=dvbf_slam.dvbf_slam_plan, specs=dvbf_slam.dvbf_slam_specs,
                run=dvbf_slam.run_dvbf_slam, report=dvbf_slam.dvbf_slam_report)
+register_study("recovery", plan=recovery.recovery_plan, specs=recovery.recovery_specs,
+               run=recovery.run_recovery, report=recovery.recovery_report)
 _STUDIES.seal()
