@@ -56,6 +56,8 @@ class JaxConfig(NamedTuple):
         Whether to learn the likelihood / the transitions.
     sample : bool
         Sample the action from ``q(pi)`` (False: take the policy of highest probability).
+    tol : float or None
+        Early stop of fpi (``jax_schemes.fpi``); None: always ``num_iter`` sweeps.
     """
 
     layout: Layout
@@ -66,6 +68,7 @@ class JaxConfig(NamedTuple):
     learn_A: bool = False
     learn_B: bool = False
     sample: bool = True
+    tol: float | None = None
 
 
 class AgentParams(NamedTuple):
@@ -208,6 +211,7 @@ def build(
     sample: bool = True,
     num_iter: int = 16,
     tau: float = 1.0,
+    tol: float | None = None,
     goal_states=None,
     dtype=None,
 ) -> Agent:
@@ -236,6 +240,9 @@ def build(
         Sweeps of fpi, vmp and mmp, default 16.
     tau : float, optional
         Step size of vmp and mmp, default 1.
+    tol : float, optional
+        fpi stops after the first sweep in which no belief moves by more than ``tol`` (the numpy
+        ``fpi`` option); default None (always ``num_iter`` sweeps, as pymdp).
     goal_states : array_like, optional
         Goal states of the inductive term (default: from ``C_states``, as the numpy planner).
     dtype : numpy dtype, optional
@@ -251,7 +258,7 @@ def build(
         If ``model`` is not a compiled Model.
     ValueError
         For an unknown scheme, an objective term the JAX backend does not have, or invalid
-        ``policy_len`` / ``gamma`` / ``num_iter``.
+        ``policy_len`` / ``gamma`` / ``num_iter`` / ``tol``.
     SpecError
         For sparse transitions, or learning without the counts it needs.
     """
@@ -263,6 +270,10 @@ def build(
         raise ValueError(f"filter is a single-factor scheme; the model has {len(model.factors)} factors")
     if not (isinstance(num_iter, int | np.integer) and num_iter >= 1):
         raise ValueError(f"num_iter must be an integer >= 1, got {num_iter!r}")
+    if tol is not None and not (isinstance(tol, int | float | np.floating) and np.isfinite(tol) and tol > 0):
+        raise ValueError(f"tol must be a positive number or None, got {tol!r}")
+    if tol is not None and scheme != "fpi":
+        raise ValueError(f"tol is an option of fpi, not of {scheme!r}")
     objective = check_plan_settings(policy_len, gamma, objective)
     weights = je.weights_of(objective or efe.pymdp_like())
     if learn_A and any(model.A[m].counts is None for m in range(len(model.modalities))):
@@ -274,7 +285,7 @@ def build(
                             dtype=dtype)
     policies = enumerate_policies(model.num_controls, int(policy_len))
     config = JaxConfig(layout, scheme, int(num_iter), float(tau), _nested(policies), bool(learn_A),
-                       bool(learn_B), bool(sample))
+                       bool(learn_B), bool(sample), None if tol is None else float(tol))
     dt = arrays.D[0].dtype
     w = je.EFEWeights(*(jnp.asarray(x, dtype=dt) for x in weights))
     params = AgentParams(arrays, jnp.asarray(gamma, dtype=dt), w, jnp.asarray(lr_A, dtype=dt),
@@ -370,7 +381,7 @@ def step(config: JaxConfig, state: AgentState, obs, action=None) -> tuple[AgentS
     layout, p = config.layout, state.params
     arrays = p.arrays
     ev = js.evidence(layout, arrays, obs)
-    opts = {"num_iter": config.num_iter, "tau": config.tau}
+    opts = {"num_iter": config.num_iter, "tau": config.tau, "tol": config.tol}
     kw = {k: opts[k] for k in js.OPTIONS[config.scheme]}
     qs, F = js.SCHEMES[config.scheme](layout, arrays, state.prior, ev, **kw)
     if config.learn_A:

@@ -394,10 +394,11 @@ def marginal_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs, f: int) -> np
     """``E_{q(other deps)}[loglik]`` as a function of factor ``f`` (which must be in ``deps``)."""
     x = loglik
     keep = deps.index(f)
-    # contract the trailing axes first so the axis numbers of the leading ones stay valid
-    for axis in range(len(deps) - 1, -1, -1):
-        if axis != keep:
-            x = np.tensordot(x, qs[deps[axis]], axes=([axis], [0]))
+    # the axes after f's as matrix-vector products on the last axis, then those before it on the first
+    for axis in range(len(deps) - 1, keep, -1):
+        x = x @ qs[deps[axis]]
+    for axis in range(keep):
+        x = (qs[deps[axis]] @ x.reshape(x.shape[0], -1)).reshape(x.shape[1:])
     return x
 
 

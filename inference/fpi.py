@@ -47,16 +47,24 @@ def fpi_step(prior, evidence, num_iter: int = 16, tol: float | None = None):
             log_q = log_q + ll
         qs = [softmax(log_q)]
         return qs, mean_field_free_energy(qs, log_prior, logliks), 1
+    # modalities with the same factors are summed once; those of one factor are constant per sweep
+    groups: dict = {}
+    for deps, ll, _ in logliks:
+        groups[deps] = groups[deps] + ll if deps in groups else ll
+    const = [lp.copy() for lp in log_prior]
+    for deps, ll in groups.items():
+        if len(deps) == 1:
+            const[deps[0]] += ll
+    multi = [[(deps, ll) for deps, ll in groups.items() if len(deps) > 1 and f in deps] for f in range(F)]
     qs = [np.full(p.shape[0], 1.0 / p.shape[0]) for p in prior]
     it = 0
     while it < num_iter:
         it += 1
         new = []
         for f in range(F):
-            log_q = log_prior[f].copy()
-            for deps, ll, _ in logliks:
-                if f in deps:
-                    log_q = log_q + marginal_loglik(ll, deps, qs, f)
+            log_q = const[f]
+            for deps, ll in multi[f]:
+                log_q = log_q + marginal_loglik(ll, deps, qs, f)
             new.append(softmax(log_q))
         delta = max(float(np.abs(a - b).max()) for a, b in zip(new, qs, strict=True))
         qs = new

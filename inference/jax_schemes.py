@@ -137,7 +137,7 @@ def mean_field_free_energy(layout, qs, log_prior, lls):
     return fe
 
 
-def fpi(layout, arrays, prior, ev: Evidence, *, num_iter: int = 16):
+def fpi(layout, arrays, prior, ev: Evidence, *, num_iter: int = 16, tol: float | None = None):
     """Fixed-point iteration, one time step (the schedule of the numpy ``fpi``).
 
     Parameters
@@ -149,6 +149,9 @@ def fpi(layout, arrays, prior, ev: Evidence, *, num_iter: int = 16):
     ev : Evidence
     num_iter : int, optional
         Simultaneous sweeps for several factors (one exact pass for one factor); default 16.
+    tol : float, optional
+        Stop after the first sweep in which no belief moves by more than ``tol`` (as the numpy
+        ``fpi``; under ``vmap`` each agent keeps the beliefs of its own last sweep). Off by default.
 
     Returns
     -------
@@ -187,7 +190,20 @@ def fpi(layout, arrays, prior, ev: Evidence, *, num_iter: int = 16):
         return tuple(new)
 
     start = tuple(lv / jnp.sum(lv) for lv in (jnp.asarray(x, dtype=prior[0].dtype) for x in arrays.live))
-    qs = jax.lax.fori_loop(0, num_iter, sweep, start, unroll=True)
+    if tol is None:
+        qs = jax.lax.fori_loop(0, num_iter, sweep, start, unroll=True)
+    else:
+        def moving(carry):
+            it, _, delta = carry
+            return (it < num_iter) & (delta >= tol)
+
+        def body(carry):
+            it, qs, _ = carry
+            new = sweep(it, qs)
+            delta = jnp.max(jnp.stack([jnp.max(jnp.abs(a - b)) for a, b in zip(new, qs, strict=True)]))
+            return it + 1, new, delta
+
+        _, qs, _ = jax.lax.while_loop(moving, body, (0, start, jnp.asarray(jnp.inf, dtype=start[0].dtype)))
     return qs, mean_field_free_energy(layout, qs, log_prior, lls)
 
 
@@ -333,7 +349,8 @@ mmp = _one_step("mmp")
 #: the one-step schemes by name (the names of the numpy registry)
 SCHEMES = {"exact": exact, "filter": bayes_filter, "fpi": fpi, "vmp": vmp, "mmp": mmp}
 #: the options each accepts
-OPTIONS = {"exact": (), "filter": (), "fpi": ("num_iter",), "vmp": ("num_iter", "tau"), "mmp": ("num_iter", "tau")}
+OPTIONS = {"exact": (), "filter": (), "fpi": ("num_iter", "tol"), "vmp": ("num_iter", "tau"),
+           "mmp": ("num_iter", "tau")}
 
 
 def predict(arrays, qs, action):

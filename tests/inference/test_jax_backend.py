@@ -86,6 +86,34 @@ def test_one_step_schemes_match_numpy(name, scheme):
         assert abs(float(F) - info.free_energy) < TOL
 
 
+@pytest.mark.parametrize("name", MULTI_FACTOR)
+def test_fpi_stops_early_where_the_numpy_fpi_does(name):
+    """With ``tol`` both stop after the same sweep: equal to each other, not to 16 sweeps (and a
+    vmapped batch keeps each agent's own stop)."""
+    model = MODELS[name]()
+    layout, arrays = to_jax(model)
+    obs, _ = random_sequence(model, 4, seed=3, missing=0.0)
+    rng = np.random.default_rng(2)
+    priors = [[rng.dirichlet(np.ones(n)) for n in model.num_states] for _ in obs]
+    batch, early = [], []
+    for o, prior in zip(obs, priors, strict=True):
+        q_np, info = inference.get("fpi")(model, prior, [o], tol=1e-3)
+        q_16, _ = inference.get("fpi")(model, prior, [o])
+        ev = _evidence(layout, arrays, o)
+        q_j, F = js.fpi(layout, arrays, tuple(jnp.asarray(p) for p in prior), ev, tol=1e-3)
+        for a, b in zip(q_j, q_np, strict=True):
+            np.testing.assert_allclose(np.asarray(a), b, atol=TOL)
+        assert abs(float(F) - info.free_energy) < TOL
+        early.append(max(np.abs(a - b).max() for a, b in zip(q_np, q_16, strict=True)) > 1e-8)
+        batch.append((tuple(jnp.asarray(p) for p in prior), ev, q_np))
+    assert any(early)  # some steps did stop before 16 sweeps
+    stack = jax.tree_util.tree_map(lambda *x: jnp.stack(x), *[(p, e) for p, e, _ in batch])
+    q_b, _ = jax.vmap(lambda p, e: js.fpi(layout, arrays, p, e, tol=1e-3))(*stack)
+    for i, (_, _, q_np) in enumerate(batch):
+        for f, b in enumerate(q_np):
+            np.testing.assert_allclose(np.asarray(q_b[f][i]), b, atol=TOL)
+
+
 @pytest.mark.parametrize("name", MODELS)
 @pytest.mark.parametrize("kind", ["vmp", "mmp"])
 def test_windows_over_whole_sequences_match_numpy(name, kind):
@@ -249,6 +277,10 @@ def test_bad_inputs_are_refused():
         jax_agent.build(_tmaze(), scheme="filter")
     with pytest.raises(ValueError, match="no EFE term 'collision'"):
         jax_agent.build(_tmaze(), objective=efe.exploration())
+    with pytest.raises(ValueError, match="tol must be a positive number or None, got -1"):
+        jax_agent.build(_tmaze(), tol=-1)
+    with pytest.raises(ValueError, match="tol is an option of fpi, not of 'vmp'"):
+        jax_agent.build(_tmaze(), scheme="vmp", tol=1e-6)
     with pytest.raises(ValueError, match="enumeration only"):
         loop.init(_tmaze(), planner="mcts", backend="jax")
     with pytest.raises(ValueError, match="unknown backend"):
