@@ -203,9 +203,16 @@ def recovery_report(study_dir: Path, plan, results) -> str:
             ax.legend(fontsize=8)
         save_figure(fig, study_dir / "parameters.png", dpi=100)
         out.append("![parameter recovery](parameters.png)")
-    if mats:
-        fig, axes = plt.subplots(1, len(mats), figsize=(4.5 * len(mats), 4.2), squeeze=False)
-        for ax, (env, seed, names, M) in zip(axes[0], mats, strict=True):
+    if mats:  # one row per task, one column per dataset
+        rows_of = sorted({e for e, *_ in mats}, key=[e for e, *_ in mats].index)
+        cols_of = sorted({s for _, s, *_ in mats})
+        fig, axes = plt.subplots(len(rows_of), len(cols_of), figsize=(4.5 * len(cols_of), 4.2 * len(rows_of)),
+                                 squeeze=False)
+        for ax in axes.flat:
+            ax.set_visible(False)
+        for env, seed, names, M in mats:
+            ax = axes[rows_of.index(env), cols_of.index(seed)]
+            ax.set_visible(True)
             ax.imshow(M, vmin=0, vmax=1, cmap="Blues")
             for i in range(M.shape[0]):
                 for j in range(M.shape[1]):
