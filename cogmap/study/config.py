@@ -184,16 +184,19 @@ def room_plan(study: str, scale: str = "reduced", seeds=None, methods=None, envs
             plan["params"] = {**plan["params"], "fault_start": 2, "fault_length": 2}
         if "aimapp_goals" in plan:
             plan["aimapp_goals"] = {**plan["aimapp_goals"], "goal_steps": 5}
-    if envs is not None:
-        plan["envs"] = list(envs)
-    if seeds is not None:
-        plan["seeds"] = list(seeds)
-    if methods is not None:
-        plan["methods"] = list(methods)
+    restrict(plan, envs=envs, seeds=seeds, methods=methods)
     default = GENERAL_STEPS if study == "generalisation" else 100
     plan["steps"] = {e: int(plan["steps"].get(e, STEPS_FULL.get(e, default))) for e in plan["envs"]}
     if study in ("obstacle", "scaling"):
         plan["stop_rule"] = FIXED_STEPS
+    return plan
+
+
+def restrict(plan: dict, envs=None, seeds=None, methods=None) -> dict:
+    """Replace the plan's environments, seeds and methods by those given (in place; returns ``plan``)."""
+    for key, given in (("envs", envs), ("seeds", seeds), ("methods", methods)):
+        if given is not None:
+            plan[key] = list(given)
     return plan
 
 

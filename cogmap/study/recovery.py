@@ -32,6 +32,8 @@ TARGETS = {"median_relative_error": 0.10, "correlation": 0.9, "model_recovery": 
 
 def recovery_plan(scale: str, seeds=None, methods=None, envs=None) -> dict:
     """Tasks are the study's environments, the two kinds of recovery its methods."""
+    from .config import restrict
+
     p = SCALE[scale]
     plan = {"study": "recovery", "scale": scale, "envs": list(TASKS), "methods": list(KINDS),
             "seeds": list(range(p["seeds"])), "steps": dict(STEPS),
@@ -41,13 +43,7 @@ def recovery_plan(scale: str, seeds=None, methods=None, envs=None) -> dict:
             unknown = [g for g in given if g not in known]
             if unknown:
                 raise ValueError(f"unknown recovery {name}(s) {unknown}; choose from {list(known)}")
-    if envs is not None:
-        plan["envs"] = list(envs)
-    if methods is not None:
-        plan["methods"] = list(methods)
-    if seeds is not None:
-        plan["seeds"] = list(seeds)
-    return plan
+    return restrict(plan, envs=envs, seeds=seeds, methods=methods)
 
 
 def recovery_specs(plan: dict) -> list[dict]:
