@@ -24,6 +24,14 @@ def _split(draws: np.ndarray) -> np.ndarray:
     return np.concatenate([x[:, :half], x[:, -half:]], axis=0)  # (2 chains, half, k)
 
 
+def _variances(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Within-chain variance ``W`` and the pooled estimate ``(n-1)/n W + B/n`` per parameter of split draws."""
+    n = x.shape[1]
+    B = n * x.mean(axis=1).var(axis=0, ddof=1)
+    W = x.var(axis=1, ddof=1).mean(axis=0)
+    return W, (n - 1) / n * W + B / n
+
+
 def split_rhat(draws) -> np.ndarray:
     """Split potential scale reduction factor per parameter (about 1 when the chains agree).
 
@@ -37,12 +45,7 @@ def split_rhat(draws) -> np.ndarray:
     numpy.ndarray
         ``(k,)`` float (a 0-d array for 2-D draws).
     """
-    x = _split(draws)
-    n = x.shape[1]
-    means = x.mean(axis=1)
-    B = n * means.var(axis=0, ddof=1)
-    W = x.var(axis=1, ddof=1).mean(axis=0)
-    var = (n - 1) / n * W + B / n
+    W, var = _variances(_split(draws))
     out = np.sqrt(np.where(W > 0, var / np.where(W > 0, W, 1.0), 1.0))
     return out[0] if np.ndim(draws) == 2 else out
 
@@ -62,13 +65,13 @@ def effective_sample_size(draws) -> np.ndarray:
     """
     x = _split(draws)
     m, n, k = x.shape
+    Ws, variances = _variances(x)
     out = np.empty(k)
     for j in range(k):
+        W, var = Ws[j], variances[j]
         y = x[:, :, j] - x[:, :, j].mean(axis=1, keepdims=True)
         f = np.fft.rfft(y, n=2 * n, axis=1)
         acov = np.fft.irfft(f * np.conj(f), axis=1)[:, :n] / n  # per-chain autocovariance
-        W = x[:, :, j].var(axis=1, ddof=1).mean()
-        var = (n - 1) / n * W + n * x[:, :, j].mean(axis=1).var(ddof=1) / n
         if var <= 0:
             out[j] = m * n
             continue
