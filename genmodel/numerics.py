@@ -34,8 +34,7 @@ def xlogx_sum(q: np.ndarray) -> float:
 
 def softmax(x: np.ndarray) -> np.ndarray:
     """``exp(x) / sum exp(x)`` over all entries, shifted by the maximum for stability."""
-    z = x - np.max(x)
-    e = np.exp(z)
+    e = np.exp(x - x.max())
     return e / e.sum()
 
 

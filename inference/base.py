@@ -135,12 +135,14 @@ def _check_distribution(x, n_live: int, cap: int, what: str) -> np.ndarray:
             f"{what}: expected a vector of length {n_live} (live) or {cap} (capacity), "
             f"got shape {arr.shape}"
         )
-    if not np.all(np.isfinite(arr)) or np.any(arr < 0):
+    total = arr.sum()  # not finite when any entry is not; nan fails the comparison below too
+    if not (np.isfinite(total) and arr.min() >= 0):
         raise InferenceError(f"{what}: entries must be finite and non-negative")
-    if arr.shape[0] > n_live and np.any(arr[n_live:] > 0):
-        raise InferenceError(f"{what}: puts mass on entries beyond the {n_live} live ones")
-    arr = arr[:n_live]
-    total = arr.sum()
+    if arr.shape[0] > n_live:
+        if np.any(arr[n_live:] > 0):
+            raise InferenceError(f"{what}: puts mass on entries beyond the {n_live} live ones")
+        arr = arr[:n_live]
+        total = arr.sum()
     if abs(total - 1.0) > ATOL:
         raise InferenceError(f"{what}: sums to {total:.6g}, expected 1 (normalise it)")
     return arr
@@ -404,8 +406,8 @@ def marginal_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs, f: int) -> np
 
 def expected_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs) -> float:
     x = loglik
-    for axis in range(len(deps) - 1, -1, -1):
-        x = np.tensordot(x, qs[deps[axis]], axes=([axis], [0]))
+    for axis in range(len(deps) - 1, -1, -1):  # contract the last axis, from the last factor back
+        x = x @ qs[deps[axis]]
     return float(x)
 
 

@@ -2,7 +2,9 @@
 
 The update schedule is that of pymdp 1.0 (``run_factorized_fpi``): start from uniform
 beliefs, then ``num_iter`` simultaneous sweeps ``q_f <- softmax(log prior_f +
-sum_m E_{q(other factors of m)}[log L_m])``; a single-factor model takes one exact pass.
+sum_m E_{q(other factors of m)}[log L_m])``; a single-factor model takes one exact pass. A
+sweep that leaves every belief bitwise unchanged ends the schedule (the remaining sweeps would
+repeat it exactly, so the result is that of all ``num_iter``).
 Logarithms use pymdp's floor (machine epsilon). Across time the prior of step ``t`` is the
 per-factor prediction of the posterior of step ``t - 1``; ``info.history`` holds the
 filtered beliefs.
@@ -66,10 +68,13 @@ def fpi_step(prior, evidence, num_iter: int = 16, tol: float | None = None):
             for deps, ll in multi[f]:
                 log_q = log_q + marginal_loglik(ll, deps, qs, f)
             new.append(softmax(log_q))
-        delta = max(float(np.abs(a - b).max()) for a, b in zip(new, qs, strict=True))
-        qs = new
-        if tol is not None and delta < tol:
+        # a sweep that leaves every belief bitwise unchanged is a fixed point: the remaining sweeps
+        # of the schedule would repeat it exactly, so stopping changes nothing
+        if all(np.array_equal(a, b) for a, b in zip(new, qs, strict=True)) or (
+                tol is not None and max(float(np.abs(a - b).max()) for a, b in zip(new, qs, strict=True)) < tol):
+            qs = new
             break
+        qs = new
     return qs, mean_field_free_energy(qs, log_prior, logliks), it
 
 

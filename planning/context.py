@@ -26,6 +26,7 @@ from .arrays import Prepared
 from .efe import entropy, xlogx
 
 _LETTERS = "abcdefghijklmnopqrstuvwxyz"
+_JOINT_LIMIT = 1 << 16  # entries of the (K, prod d_i) joint below which expect forms it outright
 
 
 class cached_property:  # noqa: N801 - a lock-free variant of functools.cached_property
@@ -52,12 +53,44 @@ def _subscripts(ndeps: int, keep_first: bool) -> str:
     return f"{lhs},{ins}->K" + ("o" if keep_first else "")
 
 
-def expect(T: np.ndarray, qs: list[np.ndarray], keep_first: bool = False) -> np.ndarray:
+def joint(qs: list[np.ndarray]) -> np.ndarray | None:
+    """``(K, d_1 * ... * d_n)`` joint of batched factor beliefs ``qs[i]`` ((K, d_i)), flattened;
+    None when it would exceed ``_JOINT_LIMIT`` entries."""
+    K = qs[0].shape[0]
+    size = 1
+    for q in qs:
+        size *= q.shape[1]
+    if K * size > _JOINT_LIMIT:
+        return None
+    out = qs[0]
+    for q in qs[1:]:
+        out = (out[:, :, None] * q[:, None, :]).reshape(K, -1)
+    return out
+
+
+def expect(T: np.ndarray, qs: list[np.ndarray], keep_first: bool = False, joint_qs=None) -> np.ndarray:
     """Contract tensor ``T`` ((o,)? x d_1 x ... x d_n) with batched factor beliefs ``qs[i]``
-    of shape (K, d_i); returns (K, o) when ``keep_first`` else (K,)."""
+    of shape (K, d_i); returns (K, o) when ``keep_first`` else (K,). ``joint_qs``: their
+    :func:`joint`, when already formed."""
     if len(qs) == 1:
         return qs[0] @ (T.T if keep_first else T)
-    return np.einsum(_subscripts(len(qs), keep_first), T, *qs, optimize=True)
+    j = joint(qs) if joint_qs is None else joint_qs
+    if j is None:  # the joint over the factors would be large: contract one factor at a time
+        return np.einsum(_subscripts(len(qs), keep_first), T, *qs, optimize=True)
+    size = j.shape[1]
+    return j @ (T.reshape(-1, size).T if keep_first else T.reshape(size))
+
+
+def _predict(B: np.ndarray, q: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """``(K, n)`` beliefs ``B[:, :, u_k] q_k`` of ``K`` candidates from ``(K, n)`` beliefs ``q``."""
+    K, n = q.shape
+    if K * n * n <= _JOINT_LIMIT:  # small: one batched product over the candidates' matrices
+        return np.matmul(np.moveaxis(B[:, :, u], 2, 0), q[:, :, None])[:, :, 0]
+    out = np.empty_like(q)
+    for c in np.unique(u):  # large: one product per distinct control
+        rows = u == c
+        out[rows] = q[rows] @ B[:, :, c].T
+    return out
 
 
 class _Common:
@@ -136,22 +169,23 @@ class DenseStep(_Common):
         self.qs_prev = qs_prev
         self.collision = collision
         a = prep.arrays
-        self.qs = []
-        for f, q in enumerate(qs_prev):
-            B = prep.B[f]
-            u = self.actions[:, f]
-            out = np.empty_like(q)
-            for c in np.unique(u):
-                rows = u == c
-                out[rows] = q[rows] @ B[:, :, c].T
-            self.qs.append(out)
+        self.qs = [_predict(prep.B[f], q, self.actions[:, f]) for f, q in enumerate(qs_prev)]
         self._a = a
+
+    def _expect(self, T, deps, keep_first):
+        qs = [self.qs[f] for f in deps]
+        if len(deps) == 1:
+            return expect(T, qs, keep_first)
+        joints = self.__dict__.setdefault("_joints", {})  # modalities that share factors share the joint
+        if deps not in joints:
+            joints[deps] = joint(qs)
+        return expect(T, qs, keep_first, joints[deps])
 
     @cached_property
     def qo(self) -> list:
         """Per modality, ``(K, num_obs[m])`` float predicted outcome distribution of each candidate."""
         a = self._a
-        return [expect(a.live_A(m), [self.qs[f] for f in a.A_deps[m]], True) for m in range(len(a.A))]
+        return [self._expect(a.live_A(m), a.A_deps[m], True) for m in range(len(a.A))]
 
     @cached_property
     def outcome_entropy(self) -> list:
@@ -167,7 +201,7 @@ class DenseStep(_Common):
     def ambiguity(self) -> list:
         """Per modality, ``(K,)`` float expected column entropy ``E_Q(s)[H[P(o_m|s)]]`` (nats)."""
         a = self._a
-        return [expect(self.prep.HA[m], [self.qs[f] for f in a.A_deps[m]]) for m in range(len(a.A))]
+        return [self._expect(self.prep.HA[m], a.A_deps[m], False) for m in range(len(a.A))]
 
     @cached_property
     def a_novelty(self) -> list:
@@ -178,7 +212,7 @@ class DenseStep(_Common):
             if w is None:
                 out.append(None)
             else:
-                ew = expect(w, [self.qs[f] for f in a.A_deps[m]], True)
+                ew = self._expect(w, a.A_deps[m], True)
                 out.append((self.qo[m] * ew).sum(axis=1))
         return out
 
@@ -300,6 +334,15 @@ class LocalStep(_Common):
     def _stats(self) -> list:
         """Per modality: column entropies and novelty weights of the states in ``U``."""
         return [self.prep.column_stats(m, self.U) for m in range(len(self._a.A))]
+
+    def _expect(self, T, deps, keep_first):
+        qs = [self.qs[f] for f in deps]
+        if len(deps) == 1:
+            return expect(T, qs, keep_first)
+        joints = self.__dict__.setdefault("_joints", {})  # modalities that share factors share the joint
+        if deps not in joints:
+            joints[deps] = joint(qs)
+        return expect(T, qs, keep_first, joints[deps])
 
     @cached_property
     def qo(self) -> list:

@@ -41,6 +41,25 @@ def set_threads(n: int | None) -> None:
     _threads = n
 
 
+class _Limit:
+    """Sets the BLAS pools above ``n`` threads to ``n`` on entry and restores them on exit (a
+    direct, cheaper form of ``threadpoolctl``'s ``limit``: planning enters it once per decision)."""
+
+    def __init__(self, libraries, n: int):
+        self.libraries, self.n, self.saved = libraries, n, []
+
+    def __enter__(self):
+        self.saved = [(lib, k) for lib in self.libraries if (k := lib.get_num_threads()) is not None and k > self.n]
+        for lib, _ in self.saved:
+            lib.set_num_threads(self.n)
+        return self
+
+    def __exit__(self, *exc):
+        for lib, k in self.saved:
+            lib.set_num_threads(k)
+        return False
+
+
 def limited():
     """Context manager applying :func:`threads` to the BLAS libraries loaded in this process."""
     global _controller
@@ -50,5 +69,5 @@ def limited():
     if _controller is None:
         from threadpoolctl import ThreadpoolController
 
-        _controller = ThreadpoolController()
-    return _controller.limit(limits=n, user_api="blas")
+        _controller = ThreadpoolController().select(user_api="blas").lib_controllers
+    return _Limit(_controller, n)
