@@ -12,7 +12,7 @@ with every agent holding its own copy of the model arrays, as pymdp's batched ``
 (``cogmap_steps_per_s``, the like-for-like ratio), and as a population sharing one copy
 (``cogmap_shared_steps_per_s``: ``jax_agent.population``). Float64 on both sides.
 
-    python bench/batched.py [--steps 20] [--json FILE]
+    python bench/batched.py [--steps 20] [--batches 1 64 ...] [--models tmaze grid100] [--json FILE]
 """
 
 from __future__ import annotations
@@ -146,12 +146,15 @@ def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=50, help="timed calls per run (after the compiling ones)")
     ap.add_argument("--batches", type=int, nargs="*", default=list(BATCHES))
+    ap.add_argument("--models", nargs="*", choices=("tmaze", "grid100"), default=["tmaze", "grid100"])
     ap.add_argument("--json", metavar="FILE", help="write the rows as JSON")
     args = ap.parse_args(argv)
     rows, numpy_rows = [], []
     print(f"{'model':>7} {'batch':>6} {'cogmap steps/s':>15} {'pymdp steps/s':>14} {'ratio':>6} "
           f"{'shared steps/s':>15} {'ratio':>6} {'compile s':>8} {'pymdp':>8} {'max |dq|':>9}")
     for name, build in (("tmaze", tmaze_model), ("grid100", grid_model)):
+        if name not in args.models:
+            continue
         model = build()
         for batch in args.batches:
             inputs = world_inputs(model, batch, args.steps + WARM, seed=batch)

@@ -29,9 +29,11 @@ from cogmap.genmodel import Model, SpecError
 from cogmap.inference.learning import learn_observation
 from cogmap.inference.registry import check_options
 from cogmap.planning import efe
+from cogmap.planning.action_selection import check_habits, check_selection, control_probabilities
 from cogmap.planning.decide import check_plan_settings
 from cogmap.planning.mcts import MCTSConfig
 from cogmap.planning.planners import PlanSettings, available_planners, get_planner
+from cogmap.planning.policies import enumerate_policies
 
 
 class LoopConfig(NamedTuple):
@@ -59,6 +61,12 @@ class LoopConfig(NamedTuple):
         Sample the action from the policy posterior (False: its mode); default True.
     scheme_options : dict or None
         Keyword options of the inference scheme.
+    log_E : numpy.ndarray or None
+        ``(P,)`` float log habits over the enumerated policies (None: uniform).
+    alpha : float
+        Action precision, default 1.
+    sampling : str
+        ``"policy"`` (default) or ``"marginal"`` (:mod:`cogmap.planning.action_selection`).
     """
     scheme: str = "fpi"
     planner: str = "enumerate"
@@ -72,6 +80,9 @@ class LoopConfig(NamedTuple):
     lr_B: float = 1.0
     sample: bool = True  # sample the action from the policy posterior (False: its mode)
     scheme_options: dict | None = None
+    log_E: np.ndarray | None = None  # log habits over the enumerated policies (None: uniform)
+    alpha: float = 1.0  # action precision
+    sampling: str = "policy"  # "policy" or "marginal"
 
 
 class LoopState(NamedTuple):
@@ -122,8 +133,9 @@ class StepInfo(NamedTuple):
     free_energy : float
         Variational free energy (nats) of this step's inference.
     action_probs : numpy.ndarray or None
-        Shaped ``num_controls``: the probability of each control combination, the marginal of
-        ``q_pi`` over the first step (what a sampling agent draws from); None with MCTS.
+        Shaped ``num_controls``: the probability of each control combination, what a sampling
+        agent draws from (with ``alpha`` 1 and ``sampling="policy"``, the marginal of ``q_pi``
+        over the first step; :mod:`cogmap.planning.action_selection`); None with MCTS.
     """
     qs: list  # posterior per factor
     action: tuple  # control per factor to apply now
@@ -150,6 +162,9 @@ def init(
     sample: bool = True,
     seed: int = 0,
     backend: str = "numpy",
+    E=None,
+    alpha: float = 1.0,
+    sampling: str = "policy",
     **scheme_options,
 ):
     """A fresh agent on ``model``; the prior is ``D``.
@@ -180,7 +195,7 @@ def init(
     lr_A, lr_B : float, optional
         Learning rates, default 1.
     sample : bool, optional
-        Sample actions from the policy posterior (default) instead of taking its mode.
+        Sample actions (default) instead of taking the mode (:mod:`cogmap.planning.action_selection`).
     seed : int, optional
         Seed of the agent's generator, default 0.
     backend : str, optional
@@ -188,6 +203,16 @@ def init(
         ``"jax"``: the jitted step of :mod:`cogmap.jax_agent` (dense models, the enumerate
         planner, the schemes and EFE terms it has), returned as a :class:`JaxLoop` that
         :func:`step` runs the same way.
+    E : array_like, optional
+        Habits: ``(P,)`` positive prior weights over the ``P`` enumerated policies, in the order of
+        :func:`cogmap.planning.enumerate_policies` (normalised here); ``q(pi) = softmax(ln E -
+        gamma G)``. Default uniform. Enumerate planner only.
+    alpha : float, optional
+        Action precision: controls are drawn from ``softmax(alpha ln q)``; default 1 (pymdp's
+        ``Agent`` defaults to 1 too).
+    sampling : str, optional
+        ``"policy"`` (default: a policy, then its first step; pymdp's ``sampling_mode="full"``) or
+        ``"marginal"`` (each factor's control from its marginal; pymdp's default).
     **scheme_options
         Passed to the inference scheme (e.g. ``num_iter=16``).
 
@@ -202,7 +227,8 @@ def init(
     KeyError
         For an unknown inference scheme.
     ValueError
-        For an unknown planner or objective name, or invalid ``policy_len`` / ``gamma``;
+        For an unknown planner or objective name, invalid ``policy_len`` / ``gamma`` / ``E`` /
+        ``alpha`` / ``sampling``;
         :class:`~cogmap.inference.InferenceError` for a scheme option the scheme does not accept
         (:func:`cogmap.inference.registry.options`).
     SpecError
@@ -219,13 +245,22 @@ def init(
         raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")
     if learn_B and any(model.B[f].counts is None or model.is_sparse(f) for f in range(len(model.factors))):
         raise SpecError("learn_B needs dense transitions with Dirichlet counts (pB) for every factor")
+    alpha = check_selection(alpha, sampling)
+    log_E = None
+    if E is not None:
+        if planner != "enumerate":
+            raise ValueError(f"E (habits) weighs the enumerated policies: it needs planner 'enumerate', "
+                             f"not {planner!r}")
+        log_E = check_habits(E, len(enumerate_policies(model.num_controls, int(policy_len))))
     if backend == "jax":
+        if log_E is not None or alpha != 1.0 or sampling != "policy":
+            raise ValueError("habits (E), alpha and sampling='marginal' are not available on the jax backend yet")
         return _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_A, learn_B, lr_A,
                          lr_B, sample, seed, scheme_options)
     if backend != "numpy":
         raise ValueError(f"unknown backend {backend!r} (known: numpy, jax)")
     cfg = LoopConfig(scheme, planner, int(policy_len), float(gamma), objective or efe.pymdp_like(), mcts,
-                     learn_A, learn_B, lr_A, lr_B, sample, scheme_options or None)
+                     learn_A, learn_B, lr_A, lr_B, sample, scheme_options or None, log_E, alpha, sampling)
     prior = [model.live_D(f).copy() for f in range(len(model.factors))]
     return LoopState(model, cfg, prior, None, None, np.random.default_rng(seed), 0)
 
@@ -288,8 +323,10 @@ def _observation(model: Model, observation) -> list:
     return list(observation)
 
 
-def action_probabilities(q_pi: np.ndarray, policies: np.ndarray, num_controls) -> np.ndarray:
-    """Probability of each first-step control combination under ``q_pi``, shaped ``num_controls``.
+def action_probabilities(q_pi: np.ndarray, policies: np.ndarray, num_controls, alpha: float = 1.0,
+                         sampling: str = "policy") -> np.ndarray:
+    """Probability of each first-step control combination under ``q_pi``, shaped ``num_controls``
+    (:func:`cogmap.planning.action_selection.control_probabilities`).
 
     Parameters
     ----------
@@ -299,15 +336,17 @@ def action_probabilities(q_pi: np.ndarray, policies: np.ndarray, num_controls) -
         ``(P, T, F)`` int policies.
     num_controls : sequence of int
         Controls per factor.
+    alpha : float, optional
+        Action precision, default 1.
+    sampling : str, optional
+        ``"policy"`` (default) or ``"marginal"``.
 
     Returns
     -------
     numpy.ndarray
         Float, sums to 1.
     """
-    shape = tuple(int(u) for u in num_controls)
-    idx = np.ravel_multi_index(tuple(policies[:, 0, f] for f in range(len(shape))), shape)
-    return np.bincount(idx, weights=q_pi, minlength=int(np.prod(shape))).reshape(shape)
+    return control_probabilities(q_pi, policies, num_controls, alpha, sampling)
 
 
 def _given_action(model: Model, action) -> tuple:
@@ -362,7 +401,8 @@ def step(state, observation, action=None):
     if cfg.learn_B and state.qs is not None:
         for f, u in enumerate(state.action):
             model.B[f].learn_soft(qs[f], state.qs[f], int(u), cfg.lr_B, model.num_states[f])
-    settings = PlanSettings(cfg.policy_len, cfg.gamma, state.rng, cfg.sample, cfg.mcts)
+    settings = PlanSettings(cfg.policy_len, cfg.gamma, state.rng, cfg.sample, cfg.mcts, cfg.log_E, cfg.alpha,
+                            cfg.sampling)
     plan = get_planner(cfg.planner)(model, qs, cfg.objective, settings)
     action = tuple(int(a) for a in plan.action)
     if len(action) != len(model.factors):
@@ -370,7 +410,8 @@ def step(state, observation, action=None):
                          f"{len(model.factors)} factor(s)")
     action = given or action
     q_pi, G, policies = plan.q_pi, np.asarray(plan.G), plan.policies
-    probs = None if q_pi is None or policies is None else action_probabilities(q_pi, policies, model.num_controls)
+    probs = None if q_pi is None or policies is None else action_probabilities(q_pi, policies, model.num_controls,
+                                                                                  cfg.alpha, cfg.sampling)
     prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
     nxt = state._replace(prior=prior, qs=qs, action=action, t=state.t + 1)
     return nxt, StepInfo(qs, action, q_pi, G, policies, float(info.free_energy), probs)

@@ -7,12 +7,14 @@ An agent loop makes one decision with :func:`decide`::
     action = d.action
 
 Lower-level pieces are pure functions of arrays: :mod:`.efe` (terms, :func:`objective`,
-presets), :mod:`.policies` (enumeration, rollouts, softmax selection), :mod:`.mcts`,
+presets), :mod:`.policies` (enumeration, rollouts, softmax selection), :mod:`.action_selection`
+(habits, action precision, the control probabilities a subject's choice is scored by), :mod:`.mcts`,
 :mod:`.inductive`, :mod:`.astar`. Extension points: :func:`register_term` (an EFE term usable by
 name in :func:`objective`) and :func:`register_planner` (a planner the agent loop finds by name).
 """
 
-from . import efe, inductive
+from . import action_selection, efe, inductive
+from .action_selection import control_probabilities, select_action
 from .arrays import PlanningArrays, Prepared, from_model, prepare
 from .astar import astar_graph, astar_grid
 from .context import DenseStep, LocalStep
@@ -54,6 +56,9 @@ from .policies import (
 )
 
 __all__ = [
+    "action_selection",
+    "control_probabilities",
+    "select_action",
     "SearchResult",
     "DenseStep",
     "LocalStep",

@@ -54,6 +54,12 @@ class PlanSettings(NamedTuple):
         Sample the action from ``q(pi)``; False takes its mode.
     mcts : MCTSConfig or None
         Depth and simulations for tree search (None: the defaults).
+    log_E : numpy.ndarray or None
+        ``(P,)`` log habits over the enumerated policies (None: uniform).
+    alpha : float
+        Action precision (:mod:`~.action_selection`), default 1.
+    sampling : str
+        ``"policy"`` (default) or ``"marginal"`` (:mod:`~.action_selection`).
     """
 
     policy_len: int = 1  # steps per policy (enumeration)
@@ -61,6 +67,9 @@ class PlanSettings(NamedTuple):
     rng: np.random.Generator | None = None  # the loop's generator (the loop owns its state)
     sample: bool = True  # sample the action from q(pi); False: take its mode
     mcts: MCTSConfig | None = None  # depth / simulations for tree search (None: defaults)
+    log_E: np.ndarray | None = None  # log habits over the enumerated policies (None: uniform)
+    alpha: float = 1.0  # action precision
+    sampling: str = "policy"  # "policy" or "marginal" (planning.action_selection)
 
 
 class Plan(NamedTuple):
@@ -103,7 +112,7 @@ accepting_planners = PLANNERS.accepting
 
 # -- the two built-in planners -----------------------------------------------------------------
 def enumerate_planner(model, qs, objective, settings: PlanSettings) -> Plan:
-    """Every policy of ``settings.policy_len`` steps, ``q(pi) = softmax(-gamma G)`` (Eq. 4).
+    """Every policy of ``settings.policy_len`` steps, ``q(pi) = softmax(ln E - gamma G)`` (Eq. 4).
 
     Parameters
     ----------
@@ -125,7 +134,8 @@ def enumerate_planner(model, qs, objective, settings: PlanSettings) -> Plan:
 
     rng = settings.rng if settings.sample else None
     action, q_pi, G, policies = infer_policies(model, qs, objective, length=settings.policy_len,
-                                               gamma=settings.gamma, rng=rng)
+                                               gamma=settings.gamma, rng=rng, log_E=settings.log_E,
+                                               alpha=settings.alpha, sampling=settings.sampling)
     return Plan(tuple(int(a) for a in action), G, q_pi, policies)
 
 

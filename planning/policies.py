@@ -9,6 +9,7 @@ import numpy as np
 
 from cogmap.genmodel.numerics import softmax
 
+from .action_selection import select_action
 from .arrays import Prepared, as_arrays, prepare
 from .context import DenseStep
 from .efe import Objective
@@ -178,6 +179,9 @@ def infer_policies(
     gamma: float = 16.0,
     obstacles=None,
     rng: np.random.Generator | None = None,
+    log_E: np.ndarray | None = None,
+    alpha: float = 1.0,
+    sampling: str = "policy",
 ):
     """Enumerate, evaluate and pick a policy; returns its first action.
 
@@ -196,7 +200,14 @@ def infer_policies(
     obstacles : array_like, optional
         Per-control obstacle signal (first step).
     rng : numpy.random.Generator, optional
-        Sample the policy instead of taking the argmax.
+        Sample the action instead of taking the mode.
+    log_E : numpy.ndarray, optional
+        ``(P,)`` float log habits over the enumerated policies (default: uniform).
+    alpha : float, optional
+        Action precision, default 1.
+    sampling : str, optional
+        ``"policy"`` (default: a policy, then its first step) or ``"marginal"`` (each factor's
+        control from its marginal); see :mod:`~.action_selection`.
 
     Returns
     -------
@@ -213,6 +224,5 @@ def infer_policies(
     a = arrays.arrays if isinstance(arrays, Prepared) else arrays
     policies = enumerate_policies(a.num_controls, length)
     G = evaluate_policies(arrays, qs, policies, objective, obstacles)
-    q = policy_posterior(G, gamma)
-    i = select(q, rng)
-    return policies[i, 0].copy(), q, G, policies
+    q = policy_posterior(G, gamma, log_E)
+    return select_action(q, policies, a.num_controls, alpha, sampling, rng), q, G, policies
