@@ -205,7 +205,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "others from --plugin modules)")
     e.add_argument("--scheme", default="filter",
                    help="inference scheme that localises the agent: filter (default, the paper's exact filter), "
-                   "exact, fpi, vmp, mmp, or one registered by a --plugin module")
+                   "exact, fpi, vmp, vmp_pymdp, mmp, or one registered by a --plugin module")
     e.add_argument("--out", default="runs/explore", help="run directory (default: runs/explore)")
     e.add_argument("--quiet", action="store_true", help="no progress bar")
     e.add_argument("--checkpoint-every", type=decisions, default=10, metavar="N",

@@ -49,7 +49,7 @@ class JaxConfig(NamedTuple):
     num_iter : int
         Sweeps of the iterative schemes.
     tau : float
-        Step size of VMP / MMP.
+        Step size of ``vmp_pymdp`` / ``mmp``.
     policies : tuple
         ``(P, T, F)`` nested tuple of int: the enumerated policies.
     learn_A, learn_B : bool
@@ -57,7 +57,8 @@ class JaxConfig(NamedTuple):
     sample : bool
         Sample the action from ``q(pi)`` (False: take the policy of highest probability).
     tol : float or None
-        Early stop of fpi (``jax_schemes.fpi``); None: always ``num_iter`` sweeps.
+        Early stop of fpi and vmp (``jax_schemes.fpi``, ``jax_schemes.vmp``); None: always
+        ``num_iter`` sweeps.
     """
 
     layout: Layout
@@ -210,7 +211,7 @@ def build(
     lr_B: float = 1.0,
     sample: bool = True,
     num_iter: int = 16,
-    tau: float = 1.0,
+    tau: float | None = None,
     tol: float | None = None,
     goal_states=None,
     dtype=None,
@@ -222,7 +223,8 @@ def build(
     model : Model
         Compiled model with dense transitions.
     scheme : str, optional
-        ``"exact"``, ``"filter"``, ``"fpi"`` (default), ``"vmp"`` or ``"mmp"``.
+        ``"exact"``, ``"filter"``, ``"fpi"`` (default), ``"vmp"`` (coordinate ascent on the
+        mean-field free energy), ``"vmp_pymdp"`` or ``"mmp"`` (pymdp 1.0's simultaneous updates).
     policy_len : int, optional
         Steps per enumerated policy, default 1.
     gamma : float, optional
@@ -237,12 +239,12 @@ def build(
     sample : bool, optional
         Sample actions (default) or take the most probable policy.
     num_iter : int, optional
-        Sweeps of fpi, vmp and mmp, default 16.
+        Sweeps of fpi, vmp, vmp_pymdp and mmp, default 16.
     tau : float, optional
-        Step size of vmp and mmp, default 1.
+        Step size of vmp_pymdp and mmp, default 1 (the other schemes refuse it).
     tol : float, optional
-        fpi stops after the first sweep in which no belief moves by more than ``tol`` (the numpy
-        ``fpi`` option); default None (always ``num_iter`` sweeps, as pymdp).
+        fpi and vmp stop after the first sweep in which no belief moves by more than ``tol`` (the
+        numpy schemes' option); default None (always ``num_iter`` sweeps, as pymdp).
     goal_states : array_like, optional
         Goal states of the inductive term (default: from ``C_states``, as the numpy planner).
     dtype : numpy dtype, optional
@@ -258,7 +260,8 @@ def build(
         If ``model`` is not a compiled Model.
     ValueError
         For an unknown scheme, an objective term the JAX backend does not have, or invalid
-        ``policy_len`` / ``gamma`` / ``num_iter`` / ``tol``.
+        ``policy_len`` / ``gamma`` / ``num_iter`` / ``tol``, or ``tol`` / ``tau`` given to a scheme
+        that does not take it.
     SpecError
         For sparse transitions, or learning without the counts it needs.
     """
@@ -272,8 +275,12 @@ def build(
         raise ValueError(f"num_iter must be an integer >= 1, got {num_iter!r}")
     if tol is not None and not (isinstance(tol, int | float | np.floating) and np.isfinite(tol) and tol > 0):
         raise ValueError(f"tol must be a positive number or None, got {tol!r}")
-    if tol is not None and scheme != "fpi":
-        raise ValueError(f"tol is an option of fpi, not of {scheme!r}")
+    for option, value in (("tol", tol), ("tau", tau)):
+        if value is not None and option not in js.OPTIONS[scheme]:
+            takers = " and ".join(name for name, opts in js.OPTIONS.items() if option in opts)
+            why = " (its coordinate updates are exact steps; pymdp 1.0's damped ones are 'vmp_pymdp')" \
+                if (option, scheme) == ("tau", "vmp") else ""
+            raise ValueError(f"{option} is an option of {takers}, not of {scheme!r}{why}")
     objective = check_plan_settings(policy_len, gamma, objective)
     weights = je.weights_of(objective or efe.pymdp_like())
     if learn_A and any(model.A[m].counts is None for m in range(len(model.modalities))):
@@ -284,8 +291,8 @@ def build(
     layout, arrays = to_jax(model, goal_dist=je.goal_distances_of(model, goal_states), goal_factor=f_goal,
                             dtype=dtype)
     policies = enumerate_policies(model.num_controls, int(policy_len))
-    config = JaxConfig(layout, scheme, int(num_iter), float(tau), _nested(policies), bool(learn_A),
-                       bool(learn_B), bool(sample), None if tol is None else float(tol))
+    config = JaxConfig(layout, scheme, int(num_iter), 1.0 if tau is None else float(tau), _nested(policies),
+                       bool(learn_A), bool(learn_B), bool(sample), None if tol is None else float(tol))
     dt = arrays.D[0].dtype
     w = je.EFEWeights(*(jnp.asarray(x, dtype=dt) for x in weights))
     params = AgentParams(arrays, jnp.asarray(gamma, dtype=dt), w, jnp.asarray(lr_A, dtype=dt),

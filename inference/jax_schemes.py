@@ -8,14 +8,16 @@ on the arrays of :func:`cogmap.genmodel.jax_model.to_jax`, with ``prior`` one ``
 belief per factor and ``evidence`` from :func:`evidence` (one observation vector per modality:
 one-hot for an outcome, a distribution for a soft observation, all zeros when the modality did
 not report). They are the numpy schemes of this package (``exact``, ``filter``, ``fpi``,
-``vmp``, ``mmp``) written as array programs, with the same update schedules, the same log floor
-and the same free energies; the tests hold them to the numpy results within 1e-10 in float64.
+``vmp``, ``vmp_pymdp``, ``mmp``) written as array programs, with the same update schedules, the
+same log floor and the same free energies; the tests hold them to the numpy results within 1e-10
+in float64.
 The numpy schemes stay the reference: they check their inputs, refuse observations of zero
 probability and run on sparse growing maps, which these functions do not (a jitted function
 cannot raise on values).
 
-:func:`window` runs VMP or MMP over a whole sequence at once, as the numpy schemes do with
-``window=None``.
+:func:`window` runs ``vmp`` (coordinate ascent on the mean-field free energy,
+:func:`mean_field_window`), ``vmp_pymdp`` or ``mmp`` (pymdp 1.0's simultaneous updates) over a
+whole sequence at once, as the numpy schemes do with ``window=None``.
 """
 
 from __future__ import annotations
@@ -249,13 +251,15 @@ def bayes_filter(layout, arrays, prior, ev: Evidence):
     return exact(layout, arrays, prior, ev)
 
 
-def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter: int = 16, tau: float = 1.0):
-    """VMP or MMP over a whole sequence (the numpy schemes with ``window=None``).
+def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter: int = 16,
+           tau: float | None = None, tol: float | None = None):
+    """``vmp``, ``vmp_pymdp`` or ``mmp`` over a whole sequence (the numpy schemes with ``window=None``).
 
     Parameters
     ----------
     kind : str
-        ``"vmp"`` or ``"mmp"``.
+        ``"vmp"`` (coordinate ascent, :func:`mean_field_window`), ``"vmp_pymdp"`` or ``"mmp"``
+        (pymdp 1.0's simultaneous updates).
     layout, arrays
         The model.
     prior : tuple of jax.Array
@@ -265,9 +269,12 @@ def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter
     actions : jax.Array
         ``(T - 1, F)`` int controls.
     num_iter : int, optional
-        Simultaneous sweeps, default 16.
+        Sweeps, default 16.
     tau : float, optional
-        Step size, default 1.
+        Step size of ``vmp_pymdp`` and ``mmp`` (default 1); ``vmp`` takes exact coordinate steps
+        and refuses it.
+    tol : float, optional
+        Early stop of ``vmp`` (:func:`mean_field_window`); the other two refuse it.
 
     Returns
     -------
@@ -276,9 +283,27 @@ def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter
     terms : jax.Array
         ``(T,)`` per-step terms of the window's mean-field free energy (their sum is the free
         energy of the window; the last is the numpy scheme's ``info.free_energy``).
+
+    Raises
+    ------
+    ValueError
+        For another ``kind``, or an option the scheme does not take.
     """
-    if kind not in ("vmp", "mmp"):
-        raise ValueError(f"window runs 'vmp' or 'mmp', got {kind!r}")
+    if kind not in ("vmp", "vmp_pymdp", "mmp"):
+        raise ValueError(f"window runs 'vmp', 'vmp_pymdp' or 'mmp', got {kind!r}")
+    if kind == "vmp":
+        if tau is not None:
+            raise ValueError("tau is an option of vmp_pymdp and mmp, not of 'vmp' (coordinate ascent takes "
+                             "exact steps)")
+        return mean_field_window(layout, arrays, prior, evs, actions, num_iter=num_iter, tol=tol)
+    if tol is not None:
+        raise ValueError(f"tol is an option of vmp, not of {kind!r}")
+    return _simultaneous_window(kind, layout, arrays, prior, evs, actions, num_iter, 1.0 if tau is None else tau)
+
+
+def _window_arrays(layout, arrays, prior, evs: Evidence, actions):
+    """Floored log-likelihoods ``(T, ...)`` per modality (zero where missing), log priors, the
+    transitions ``(T - 1, next, current)`` per factor under ``actions`` and their floored logs."""
     T = evs.present.shape[0]
     F = layout.num_factors
     lls = [jnp.where(evs.present[:, m].reshape((T,) + (1,) * (lik.ndim - 1)), floor_log(lik), 0.0)
@@ -286,7 +311,100 @@ def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter
     log_prior = [floor_log(p) for p in prior]
     actions = jnp.asarray(actions).reshape(T - 1, F)
     Bt = [jnp.moveaxis(arrays.B[f][:, :, actions[:, f]], -1, 0) for f in range(F)]  # (T-1, next, current)
-    logB = [floor_log(b) for b in Bt]
+    return lls, log_prior, Bt, [floor_log(b) for b in Bt]
+
+
+def _uniform_start(arrays, prior, T):
+    return tuple(jnp.broadcast_to(lv / jnp.sum(lv), (T, lv.shape[0])).astype(prior[0].dtype)
+                 for lv in (jnp.asarray(x, dtype=prior[0].dtype) for x in arrays.live))
+
+
+def mean_field_window(layout, arrays, prior, evs: Evidence, actions, *, num_iter: int = 16,
+                      tol: float | None = None):
+    """``vmp``: coordinate ascent on the mean-field free energy of a whole sequence (the numpy
+    :func:`cogmap.inference.mean_field.vmp` with ``window=None``).
+
+    Each sweep scans the steps ``t = 0..T-1`` and updates the factors of a step in order, each
+    to the minimiser of the free energy given the current other marginals: the previous step's
+    (already updated in this sweep), the next step's (from the last sweep) and the other factors
+    of the same step.
+
+    Parameters
+    ----------
+    layout, arrays
+        The model.
+    prior : tuple of jax.Array
+        Belief per factor at the first step.
+    evs : Evidence
+        Stacked over time: ``lik[m]`` has a leading ``T`` axis, ``present`` is ``(T, M)``.
+    actions : jax.Array
+        ``(T - 1, F)`` int controls.
+    num_iter : int, optional
+        Sweeps, default 16.
+    tol : float, optional
+        Stop after the first sweep in which no belief moves by more than ``tol`` (as the numpy
+        scheme; under ``vmap`` each element keeps the beliefs of its own last sweep). Off by
+        default.
+
+    Returns
+    -------
+    qs : tuple of jax.Array
+        Per factor ``(T, capacity[f])`` smoothed beliefs.
+    terms : jax.Array
+        ``(T,)`` per-step terms of the window's mean-field free energy.
+    """
+    T = evs.present.shape[0]
+    F = layout.num_factors
+    lls, log_prior, _, logB = _window_arrays(layout, arrays, prior, evs, actions)
+    none = [jnp.zeros((1,) + b.shape[1:], dtype=b.dtype) for b in logB]
+    into = tuple(jnp.concatenate([z, b]) for z, b in zip(none, logB, strict=True))  # (T, ...): log B_{t-1}
+    out_of = tuple(jnp.concatenate([b, z]) for z, b in zip(none, logB, strict=True))  # (T, ...): log B_t
+    first = jnp.arange(T) == 0
+    last = jnp.arange(T) == T - 1
+
+    def update_step(prev, xs):
+        q_t, q_next, ll_t, b_in, b_out, is_first, is_last = xs
+        q_t = list(q_t)
+        moved = jnp.zeros((), dtype=q_t[0].dtype)
+        for f in range(F):
+            x = jnp.where(is_first, log_prior[f], b_in[f] @ prev[f])
+            x = x + jnp.where(is_last, 0.0, q_next[f] @ b_out[f])
+            for deps, ll in zip(layout.A_deps, ll_t, strict=True):
+                if f in deps:
+                    x = x + marginal_loglik(ll, deps, q_t, f)
+            new = masked_softmax(x, arrays.live[f])
+            moved = jnp.maximum(moved, jnp.max(jnp.abs(new - q_t[f])))
+            q_t[f] = new
+        return tuple(q_t), (tuple(q_t), moved)
+
+    def sweep(qs):
+        q_next = tuple(jnp.concatenate([q[1:], jnp.zeros_like(q[:1])]) for q in qs)  # the last sweep's q_{t+1}
+        init = tuple(jnp.zeros_like(q[0]) for q in qs)
+        _, (new, moved) = jax.lax.scan(update_step, init, (qs, q_next, tuple(lls), into, out_of, first, last))
+        return new, jnp.max(moved)
+
+    start = _uniform_start(arrays, prior, T)
+    if tol is None:
+        qs = jax.lax.fori_loop(0, num_iter, lambda _, qs: sweep(qs)[0], start)
+    else:
+        def moving(carry):
+            it, _, delta = carry
+            return (it < num_iter) & (delta > tol)
+
+        def body(carry):
+            it, qs, _ = carry
+            new, delta = sweep(qs)
+            return it + 1, new, delta
+
+        _, qs, _ = jax.lax.while_loop(moving, body, (0, start, jnp.asarray(jnp.inf, dtype=start[0].dtype)))
+    return qs, window_terms(layout, prior, qs, lls, logB)
+
+
+def _simultaneous_window(kind, layout, arrays, prior, evs: Evidence, actions, num_iter, tau):
+    """``vmp_pymdp`` / ``mmp``: pymdp 1.0's simultaneous updates over a whole sequence."""
+    T = evs.present.shape[0]
+    F = layout.num_factors
+    lls, log_prior, Bt, logB = _window_arrays(layout, arrays, prior, evs, actions)
     Bn = [b / jnp.maximum(jnp.sum(b, axis=2, keepdims=True), LOG_FLOOR) for b in Bt]
     last = jnp.arange(T) == T - 1
 
@@ -299,7 +417,7 @@ def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter
         if T == 1:
             fwd = log_prior[f][None]
             bwd = jnp.zeros_like(q)
-        elif kind == "vmp":
+        elif kind == "vmp_pymdp":
             fwd = jnp.concatenate([log_prior[f][None], jnp.einsum("tij,tj->ti", logB[f], q[:-1])])
             bwd = jnp.concatenate([jnp.einsum("ti,tij->tj", q[1:], logB[f]), jnp.zeros_like(q[:1])])
         else:
@@ -312,8 +430,7 @@ def window(kind: str, layout, arrays, prior, evs: Evidence, actions, *, num_iter
     def sweep(_, qs):
         return tuple(jax.vmap(masked_softmax, in_axes=(0, None))(step_logq(qs, f), arrays.live[f]) for f in range(F))
 
-    start = tuple(jnp.broadcast_to(lv / jnp.sum(lv), (T, lv.shape[0])).astype(prior[0].dtype)
-                  for lv in (jnp.asarray(x, dtype=prior[0].dtype) for x in arrays.live))
+    start = _uniform_start(arrays, prior, T)
     qs = jax.lax.fori_loop(0, num_iter, sweep, start, unroll=True)
     return qs, window_terms(layout, prior, qs, lls, logB)
 
@@ -339,18 +456,48 @@ def _one_step(kind):
         return tuple(q[0] for q in qs), terms[0]
 
     scheme.__name__ = kind
-    scheme.__doc__ = f"{kind.upper()} on one time step (the loop's call): :func:`window` with ``T = 1``."
+    scheme.__doc__ = f"``{kind}`` on one time step (the loop's call): :func:`window` with ``T = 1``."
     return scheme
 
 
-vmp = _one_step("vmp")
+def vmp(layout, arrays, prior, ev: Evidence, *, num_iter: int = 16, tol: float | None = None):
+    """``vmp`` on one time step (the loop's call): :func:`mean_field_window` with ``T = 1``.
+
+    With one time step the sweeps run over the factors only (coordinate ascent, one factor at a
+    time given the others' current beliefs); a single factor is exact after one sweep.
+
+    Parameters
+    ----------
+    layout : Layout
+    arrays : JaxModel
+    prior : tuple of jax.Array
+        ``(capacity[f],)`` belief per factor before the observation.
+    ev : Evidence
+    num_iter : int, optional
+        Sweeps, default 16.
+    tol : float, optional
+        Early stop, as for :func:`mean_field_window`.
+
+    Returns
+    -------
+    qs : tuple of jax.Array
+    free_energy : jax.Array
+        Mean-field free energy (nats).
+    """
+    stacked = Evidence(tuple(x[None] for x in ev.lik), ev.present[None])
+    qs, terms = mean_field_window(layout, arrays, prior, stacked, jnp.zeros((0, layout.num_factors), dtype=int),
+                                  num_iter=num_iter, tol=tol)
+    return tuple(q[0] for q in qs), terms[0]
+
+
+vmp_pymdp = _one_step("vmp_pymdp")
 mmp = _one_step("mmp")
 
 #: the one-step schemes by name (the names of the numpy registry)
-SCHEMES = {"exact": exact, "filter": bayes_filter, "fpi": fpi, "vmp": vmp, "mmp": mmp}
+SCHEMES = {"exact": exact, "filter": bayes_filter, "fpi": fpi, "vmp": vmp, "vmp_pymdp": vmp_pymdp, "mmp": mmp}
 #: the options each accepts
-OPTIONS = {"exact": (), "filter": (), "fpi": ("num_iter", "tol"), "vmp": ("num_iter", "tau"),
-           "mmp": ("num_iter", "tau")}
+OPTIONS = {"exact": (), "filter": (), "fpi": ("num_iter", "tol"), "vmp": ("num_iter", "tol"),
+           "vmp_pymdp": ("num_iter", "tau"), "mmp": ("num_iter", "tau")}
 
 
 def predict(arrays, qs, action):
@@ -358,5 +505,5 @@ def predict(arrays, qs, action):
     return tuple(arrays.B[f][:, :, action[f]] @ q for f, q in enumerate(qs))
 
 
-__all__ = ["OPTIONS", "SCHEMES", "Evidence", "evidence", "exact", "bayes_filter", "fpi", "mmp",
-           "one_hot_observation", "predict", "vmp", "window", "window_terms"]
+__all__ = ["OPTIONS", "SCHEMES", "Evidence", "evidence", "exact", "bayes_filter", "fpi", "mean_field_window", "mmp",
+           "one_hot_observation", "predict", "vmp", "vmp_pymdp", "window", "window_terms"]

@@ -1,22 +1,26 @@
-"""Variational (VMP) and marginal (MMP) message passing over a window of time steps.
+"""Window message passing with simultaneous updates, as pymdp 1.0 (``vmp_pymdp``, ``mmp``).
 
 Beliefs ``q_t^f`` for every step of the window and every factor start uniform and are updated
-simultaneously, ``num_iter`` times, following pymdp 1.0 (``run_vmp`` / ``run_mmp``):
+all at once, ``num_iter`` times, following pymdp 1.0 (``run_vmp`` / ``run_mmp``):
 
 ``log q_t^f <- log q_t^f + tau * (E[log L_t] - log q_t^f + m_past + m_future)``
 
-* VMP: ``m_future = sum_s' log B[s, s'] q_{t-1}(s')`` (``log D`` at the window start) and
-  ``m_past = sum_s' q_{t+1}(s') log B[s', s]``.
-* MMP: ``m_future = 1/2 log(B q_{t-1})`` and ``m_past = 1/2 log(q_{t+1} . B~)`` with ``B~`` the
-  transition normalised over the current state; messages at the window's last step carry full
-  weight.
+* ``vmp_pymdp``: ``m_future = sum_s' log B[s, s'] q_{t-1}(s')`` (``log D`` at the window start)
+  and ``m_past = sum_s' q_{t+1}(s') log B[s', s]``. These are the messages of variational
+  message passing, but updating every belief at once from the previous sweep's neighbours is
+  not a descent on the free energy: it can oscillate and stay far from the mean-field optimum.
+  It is kept for agreement with pymdp; :mod:`cogmap.inference.mean_field` has ``vmp``, which
+  minimises the same free energy one belief at a time.
+* ``mmp``: ``m_future = 1/2 log(B q_{t-1})`` and ``m_past = 1/2 log(q_{t+1} . B~)`` with ``B~``
+  the transition normalised over the current state; messages at the window's last step carry
+  full weight.
 
 Options: ``num_iter`` (16), ``tau`` (1.0) and ``window`` (``None``: the whole sequence). With
 a window shorter than the sequence, the steps before it are filtered by fixed-point iteration
-and the predicted belief becomes the window's prior. ``info.history`` holds the smoothed beliefs
-of the window (filtered ones before it). ``info.total_free_energy`` is the mean-field free
-energy of the window (an upper bound on ``-log p(o_window)``); ``info.free_energy`` holds the
-terms of it that involve the last step.
+and the predicted belief becomes the window's prior (:func:`filter_before_window`).
+``info.history`` holds the smoothed beliefs of the window (filtered ones before it).
+``info.total_free_energy`` is the mean-field free energy of the window (an upper bound on
+``-log p(o_window)``); ``info.free_energy`` holds the terms of it that involve the last step.
 """
 
 from __future__ import annotations
@@ -64,7 +68,7 @@ def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
                     if f in deps:
                         ln_a = ln_a + marginal_loglik(ll, deps, qs[t], f)
                 last = t == T - 1
-                if kind == "vmp":
+                if kind == "vmp_pymdp":
                     fwd = log_prior[f] if t == 0 else logB[t - 1][f] @ qs[t - 1][f]
                     bwd = 0.0 if last else qs[t + 1][f] @ logB[t][f]
                 else:
@@ -80,21 +84,48 @@ def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
     return qs, free_energy_terms(model, prob, prior, qs, start)
 
 
+def check_window(window, scheme: str) -> int | None:
+    """``window`` must be None (the whole sequence) or an integer >= 1."""
+    if window is None:
+        return None
+    if isinstance(window, bool | np.bool_) or not isinstance(window, int | np.integer):
+        raise InferenceError(f"{scheme}: window must be an integer >= 1 or None, got {window!r}")
+    if window < 1:
+        raise InferenceError(f"{scheme}: window must be >= 1, got {window}")
+    return int(window)
+
+
+def filter_before_window(model, prob, window: int | None, num_iter: int):
+    """Filter the steps before the last ``window`` ones by fixed-point iteration.
+
+    Returns ``(start, history, prior)``: the first step of the window, the filtered beliefs of
+    the steps before it and the belief predicted for ``start`` (``prob.prior`` when the window
+    covers the whole sequence).
+    """
+    start = 0 if window is None else max(0, prob.T - window)
+    history = []
+    pri = list(prob.prior)
+    for t in range(start):
+        qs_t, _, _ = fpi_step(pri, prob.evidence[t], num_iter)
+        history.append(tuple(qs_t))
+        pri = predict_factorised(model, qs_t, prob.actions[t])
+    return start, history, pri
+
+
+_TITLES = {
+    "vmp_pymdp": "Variational message passing with pymdp 1.0's simultaneous updates (``run_vmp``)",
+    "mmp": "Marginal message passing with pymdp 1.0's simultaneous updates (``run_mmp``)",
+}
+
+
 def _window_scheme(kind: str):
     def scheme(model, prior, observations, actions=None, *, num_iter: int = 16, tau: float = 1.0,
                window: int | None = None):
         num_iter = check_num_iter(num_iter, kind)
         prob = prepare(model, prior, observations, actions)
-        if window is not None and window < 1:
-            raise InferenceError(f"{kind}: window must be >= 1, got {window}")
+        window = check_window(window, kind)
         check_possible(model, prob, kind)
-        start = 0 if window is None else max(0, prob.T - window)
-        history = []
-        pri = list(prob.prior)
-        for t in range(start):
-            qs_t, _, _ = fpi_step(pri, prob.evidence[t], num_iter)
-            history.append(tuple(qs_t))
-            pri = predict_factorised(model, qs_t, prob.actions[t])
+        start, history, pri = filter_before_window(model, prob, window, num_iter)
         qs, terms = _run(model, prob, start, pri, kind, num_iter, tau)
         history.extend(tuple(q) for q in qs)
         info = InferenceInfo(float(terms[-1]), tuple(history), num_iter, float(terms.sum()))
@@ -102,7 +133,7 @@ def _window_scheme(kind: str):
 
     scheme.__name__ = kind
     scheme.__qualname__ = kind
-    scheme.__doc__ = f"""{kind.upper()} over a window of time steps (see the module docstring).
+    scheme.__doc__ = f"""{_TITLES[kind]} over a window of time steps (see the module docstring).
 
     Parameters
     ----------
@@ -142,5 +173,5 @@ def _window_scheme(kind: str):
     return scheme
 
 
-vmp = _window_scheme("vmp")
+vmp_pymdp = _window_scheme("vmp_pymdp")
 mmp = _window_scheme("mmp")

@@ -64,8 +64,8 @@ class AgentConfig:
         The registered inference scheme that localises the agent at each step (its belief over
         places from ``B_s``'s prediction, ``A_o`` and ``A_p``), any that accepts AIMAPP's one-factor
         sparse model (:func:`cogmap.inference.accepting`: ``"exact"``, ``"filter"``, ``"fpi"``,
-        ``"vmp"``, ``"mmp"`` or one of yours); ``"filter"``, the exact Bayes filter of the paper, by
-        default.
+        ``"vmp"``, ``"vmp_pymdp"``, ``"mmp"`` or one of yours); ``"filter"``, the exact Bayes filter
+        of the paper, by default.
     mcts : cogmap.planning.mcts.MCTSConfig
         The planner's settings, used as they are (:data:`AIMAPP_MCTS`: depth 10 and 30 simulations,
         Appendix A.3 and Table 6; policy precision ``gamma`` 8, Eq. 4; a move is planned only when

@@ -39,7 +39,7 @@ def _run(scheme: str):
 def test_the_schemes_that_accept_aimapps_model_are_the_discrete_ones():
     model = initial_model(default_config("mini_warehouse"), np.zeros(2))
     assert model.is_sparse and len(model.factors) == 1
-    assert {"exact", "filter", "fpi", "vmp", "mmp"} <= set(inference.accepting(model))
+    assert {"exact", "filter", "fpi", "vmp", "vmp_pymdp", "mmp"} <= set(inference.accepting(model))
     assert "kernel" not in inference.accepting(model) and "particle_filter" not in inference.accepting(model)
 
 

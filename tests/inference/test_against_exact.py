@@ -114,7 +114,7 @@ def test_growth_keeps_dead_states_out():
     D = np.zeros(m.state_capacity(0))
     D[:n] = 1.0 / n
     obs = [[1, (10.0, 0.0)], [2, (11.0, 0.0)]]
-    for name in ("exact", "filter", "fpi", "vmp", "mmp"):
+    for name in ("exact", "filter", "fpi", "vmp", "vmp_pymdp", "mmp"):
         q, info = inference.get(name)(m, [D], obs, [(3,)])
         assert q[0].shape == (n,)
         assert all(h[0].shape == (n,) for h in info.history)
@@ -150,7 +150,7 @@ def test_fpi_exact_when_posterior_factorises(seed):
 
 
 @pytest.mark.parametrize("seed", SEEDS)
-@pytest.mark.parametrize("name", ["vmp", "mmp"])
+@pytest.mark.parametrize("name", ["vmp", "vmp_pymdp", "mmp"])
 def test_window_schemes_one_step_exact_when_factorised(seed, name):
     m = factorised_model(seed)
     obs, _ = random_sequence(m, 1, seed, missing=0.3)
@@ -162,7 +162,7 @@ def test_window_schemes_one_step_exact_when_factorised(seed, name):
 
 
 @pytest.mark.parametrize("seed", SEEDS)
-@pytest.mark.parametrize("name", ["fpi", "vmp", "mmp"])
+@pytest.mark.parametrize("name", ["fpi", "vmp", "vmp_pymdp", "mmp"])
 def test_mean_field_free_energy_bounds_exact(seed, name):
     m = random_model(seed, sizes=(3, 3), modalities=((0, 1), (1,)), obs_sizes=(4, 3))
     obs, act = random_sequence(m, 4, seed, missing=0.2)
@@ -192,14 +192,14 @@ def sharp_model(seed, sizes=(4, 3)):
 
 
 @pytest.mark.parametrize("seed", SEEDS)
-@pytest.mark.parametrize("name", ["fpi", "vmp", "mmp"])
+@pytest.mark.parametrize("name", ["fpi", "vmp", "vmp_pymdp", "mmp"])
 def test_map_agrees_on_well_conditioned_models(seed, name):
     from cogmap.inference.compare import generate_sequence
 
     m = sharp_model(seed)
     seq = generate_sequence(m, 5, seed)
     q, info = inference.get(name)(m, priors(m), seq.observations, seq.actions)
-    # fpi filters, vmp and mmp smooth over the window
+    # fpi filters, vmp, vmp_pymdp and mmp smooth over the window
     qe, infoe = inference.exact(m, priors(m), seq.observations, seq.actions, smooth=name != "fpi")
     checked = agree = 0
     for t in range(5):
@@ -212,11 +212,11 @@ def test_map_agrees_on_well_conditioned_models(seed, name):
     for f in range(2):
         assert int(np.argmax(q[f])) == int(np.argmax(qe[f]))
     # MMP's half-weighted transition messages can let a single observation outvote the
-    # dynamics at an interior step (seed 1: one of 10 entries); fpi and vmp agree everywhere
+    # dynamics at an interior step (seed 1: one of 10 entries); fpi and both vmps agree everywhere
     assert agree >= (0.8 * checked if name == "mmp" else checked)
 
 
-@pytest.mark.parametrize("name", ["vmp", "mmp"])
+@pytest.mark.parametrize("name", ["vmp", "vmp_pymdp", "mmp"])
 def test_window_option(name):
     m = random_model(4, sizes=(4,), modalities=((0,),))
     obs, act = random_sequence(m, 6, 4)

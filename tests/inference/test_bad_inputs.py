@@ -15,7 +15,7 @@ def model():
                              A={"o": np.array([[0.9, 0.2], [0.1, 0.8]])}, B={"s": B}))
 
 
-@pytest.mark.parametrize("name", ["exact", "fpi", "vmp", "mmp"])
+@pytest.mark.parametrize("name", ["exact", "fpi", "vmp", "vmp_pymdp", "mmp"])
 @pytest.mark.parametrize("action, message", [
     (1.0, "actions[0]: expected integer control indices, got 1.0"),
     (1.7, "actions[0]: expected integer control indices, got 1.7"),
@@ -35,7 +35,7 @@ def test_integer_actions_still_work(model):
         assert q[0].shape == (2,)
 
 
-@pytest.mark.parametrize("name", ["fpi", "vmp", "mmp"])
+@pytest.mark.parametrize("name", ["fpi", "vmp", "vmp_pymdp", "mmp"])
 @pytest.mark.parametrize("num_iter, message", [(0, "num_iter must be >= 1, got 0"), (-3, "must be >= 1, got -3"),
                                                 (2.5, "num_iter must be an integer >= 1, got 2.5")])
 def test_num_iter_below_one_or_not_an_integer_is_refused(model, name, num_iter, message):

@@ -14,9 +14,9 @@ def test_harness_runs_and_exact_has_zero_kl():
     by = {r.scheme: r for r in rows}
     assert isinstance(rows[0], Row)
     # by default only the schemes that accept a two-factor Model: no filter, kernel or particle rows
-    assert set(by) == {"exact", "fpi", "vmp", "mmp"} and not any(r.error for r in rows)
+    assert set(by) == {"exact", "fpi", "vmp", "vmp_pymdp", "mmp"} and not any(r.error for r in rows)
     assert by["exact"].kl < 1e-12
-    for name in ("fpi", "vmp", "mmp"):
+    for name in ("fpi", "vmp", "vmp_pymdp", "mmp"):
         assert by[name].kl >= 0 and np.isfinite(by[name].free_energy)
         assert 0 <= by[name].accuracy <= 1 and by[name].ms_per_step > 0
     assert "n/a" not in format_table(rows)

@@ -7,7 +7,7 @@ from inference_helpers import random_model
 from cogmap import inference
 from cogmap.inference import InferenceError, InferenceInfo
 
-SCHEMES = ("exact", "filter", "fpi", "vmp", "mmp")
+SCHEMES = ("exact", "filter", "fpi", "vmp", "vmp_pymdp", "mmp")
 
 
 @pytest.fixture(scope="module")
@@ -141,7 +141,7 @@ def test_zero_probability_observation_reported():
         inference.exact(m, [m.live_D(0)], [[1]])
 
 
-@pytest.mark.parametrize("scheme", ["exact", "filter", "fpi", "vmp", "mmp"])
+@pytest.mark.parametrize("scheme", ["exact", "filter", "fpi", "vmp", "vmp_pymdp", "mmp"])
 def test_every_scheme_refuses_an_observation_of_probability_zero_as_exact_does(scheme):
     m = random_model(3, sizes=(2,), modalities=((0,),), obs_sizes=(2,))
     m.A[0].prob[:, :] = np.array([[1.0, 1.0], [0.0, 0.0]])  # outcome 1 never happens

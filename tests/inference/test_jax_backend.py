@@ -17,7 +17,7 @@ from cogmap.planning import efe
 from cogmap.planning import jax_efe as je
 from cogmap.planning.policies import enumerate_policies, evaluate_policies
 
-SCHEMES = ("exact", "fpi", "vmp", "mmp", "filter")
+SCHEMES = ("exact", "fpi", "vmp", "vmp_pymdp", "mmp", "filter")
 TOL = 1e-10
 
 
@@ -115,15 +115,16 @@ def test_fpi_stops_early_where_the_numpy_fpi_does(name):
 
 
 @pytest.mark.parametrize("name", MODELS)
-@pytest.mark.parametrize("kind", ["vmp", "mmp"])
-def test_windows_over_whole_sequences_match_numpy(name, kind):
+@pytest.mark.parametrize(("kind", "options"), [("vmp", {}), ("vmp", {"tol": 1e-4}), ("vmp_pymdp", {}),
+                                               ("vmp_pymdp", {"tau": 0.5}), ("mmp", {})])
+def test_windows_over_whole_sequences_match_numpy(name, kind, options):
     model = MODELS[name]()
     layout, arrays = to_jax(model)
     obs, acts = random_sequence(model, 5, seed=11, missing=0.1)
     prior = [model.live_D(f) for f in range(len(model.factors))]
-    _, info = inference.get(kind)(model, prior, obs, acts)
+    _, info = inference.get(kind)(model, prior, obs, acts, **options)
     qs, terms = js.window(kind, layout, arrays, tuple(jnp.asarray(p) for p in prior), _stacked(layout, arrays, obs),
-                          jnp.asarray(acts))
+                          jnp.asarray(acts), **options)
     for t, step in enumerate(info.history):
         for f, q in enumerate(step):
             np.testing.assert_allclose(np.asarray(qs[f][t]), q, atol=TOL)
@@ -139,7 +140,7 @@ def test_padded_capacity_gives_the_live_results():
     prior = [model.live_D(f) for f in range(2)]
     padded = tuple(jnp.zeros(c).at[:n].set(p)
                    for c, n, p in zip(layout.capacity, model.num_states, prior, strict=True))
-    for scheme in ("exact", "fpi", "vmp", "mmp"):
+    for scheme in ("exact", "fpi", "vmp", "vmp_pymdp", "mmp"):
         q_np, info = inference.get(scheme)(model, prior, obs)
         q_j, F = js.SCHEMES[scheme](layout, arrays, padded, _evidence(layout, arrays, obs[0]))
         for f, n in enumerate(model.num_states):
@@ -279,8 +280,16 @@ def test_bad_inputs_are_refused():
         jax_agent.build(_tmaze(), objective=efe.exploration())
     with pytest.raises(ValueError, match="tol must be a positive number or None, got -1"):
         jax_agent.build(_tmaze(), tol=-1)
-    with pytest.raises(ValueError, match="tol is an option of fpi, not of 'vmp'"):
-        jax_agent.build(_tmaze(), scheme="vmp", tol=1e-6)
+    with pytest.raises(ValueError, match="tol is an option of fpi and vmp, not of 'vmp_pymdp'"):
+        jax_agent.build(_tmaze(), scheme="vmp_pymdp", tol=1e-6)
+    with pytest.raises(ValueError, match=r"tau is an option of vmp_pymdp and mmp, not of 'vmp' \(its coordinate"):
+        jax_agent.build(_tmaze(), scheme="vmp", tau=0.5)
+    with pytest.raises(ValueError, match="tau is an option of vmp_pymdp and mmp, not of 'fpi'"):
+        jax_agent.build(_tmaze(), tau=0.5)
+    with pytest.raises(ValueError, match="tau is an option of vmp_pymdp and mmp, not of 'vmp'"):
+        js.window("vmp", *to_jax(_tmaze()), (), None, None, tau=1.0)
+    with pytest.raises(ValueError, match="tol is an option of vmp, not of 'mmp'"):
+        js.window("mmp", *to_jax(_tmaze()), (), None, None, tol=1e-3)
     with pytest.raises(ValueError, match="enumeration only"):
         loop.init(_tmaze(), planner="mcts", backend="jax")
     with pytest.raises(ValueError, match="unknown backend"):
