@@ -33,6 +33,7 @@ from cogmap.genmodel.jax_model import JaxModel, Layout, to_jax
 from cogmap.inference import jax_schemes as js
 from cogmap.planning import efe
 from cogmap.planning import jax_efe as je
+from cogmap.planning.action_selection import check_habits, check_selection
 from cogmap.planning.decide import check_plan_settings
 from cogmap.planning.policies import enumerate_policies
 
@@ -59,6 +60,8 @@ class JaxConfig(NamedTuple):
     tol : float or None
         Early stop of fpi and vmp (``jax_schemes.fpi``, ``jax_schemes.vmp``); None: always
         ``num_iter`` sweeps.
+    sampling : str
+        ``"policy"`` or ``"marginal"`` (:mod:`cogmap.planning.action_selection`).
     """
 
     layout: Layout
@@ -70,6 +73,7 @@ class JaxConfig(NamedTuple):
     learn_B: bool = False
     sample: bool = True
     tol: float | None = None
+    sampling: str = "policy"
 
 
 class AgentParams(NamedTuple):
@@ -85,6 +89,10 @@ class AgentParams(NamedTuple):
         Weight of each EFE term.
     lr_A, lr_B : jax.Array
         Learning rates of ``A`` and ``B``.
+    log_E : jax.Array
+        ``(P,)`` log habits over the enumerated policies (uniform by default).
+    alpha : jax.Array
+        Action precision.
     """
 
     arrays: JaxModel
@@ -92,6 +100,8 @@ class AgentParams(NamedTuple):
     weights: je.EFEWeights
     lr_A: jax.Array
     lr_B: jax.Array
+    log_E: jax.Array
+    alpha: jax.Array
 
 
 class AgentState(NamedTuple):
@@ -215,6 +225,9 @@ def build(
     tol: float | None = None,
     goal_states=None,
     dtype=None,
+    E=None,
+    alpha: float = 1.0,
+    sampling: str = "policy",
 ) -> Agent:
     """A JAX-backend agent for a dense compiled model, with the settings of :func:`cogmap.loop.init`.
 
@@ -249,6 +262,10 @@ def build(
         Goal states of the inductive term (default: from ``C_states``, as the numpy planner).
     dtype : numpy dtype, optional
         Float type of the arrays (default JAX's).
+    E, alpha, sampling : optional
+        Habits over the enumerated policies, action precision and sampling mode, as for
+        :func:`cogmap.loop.init` (:mod:`cogmap.planning.action_selection`); ``E`` and ``alpha``
+        are parameters (``params.log_E``, ``params.alpha``) that can be fitted or batched.
 
     Returns
     -------
@@ -260,8 +277,8 @@ def build(
         If ``model`` is not a compiled Model.
     ValueError
         For an unknown scheme, an objective term the JAX backend does not have, or invalid
-        ``policy_len`` / ``gamma`` / ``num_iter`` / ``tol``, or ``tol`` / ``tau`` given to a scheme
-        that does not take it.
+        ``policy_len`` / ``gamma`` / ``num_iter`` / ``tol`` / ``E`` / ``alpha`` / ``sampling``, or
+        ``tol`` / ``tau`` given to a scheme that does not take it.
     SpecError
         For sparse transitions, or learning without the counts it needs.
     """
@@ -282,6 +299,9 @@ def build(
                 if (option, scheme) == ("tau", "vmp") else ""
             raise ValueError(f"{option} is an option of {takers}, not of {scheme!r}{why}")
     objective = check_plan_settings(policy_len, gamma, objective)
+    alpha = check_selection(alpha, sampling)
+    policies = enumerate_policies(model.num_controls, int(policy_len))
+    log_E = np.full(len(policies), -np.log(len(policies))) if E is None else check_habits(E, len(policies))
     weights = je.weights_of(objective or efe.pymdp_like())
     if learn_A and any(model.A[m].counts is None for m in range(len(model.modalities))):
         raise SpecError("learn_A needs Dirichlet counts (pA) for every modality")
@@ -290,13 +310,12 @@ def build(
     f_goal = model.pose.factor if model.pose is not None else 0
     layout, arrays = to_jax(model, goal_dist=je.goal_distances_of(model, goal_states), goal_factor=f_goal,
                             dtype=dtype)
-    policies = enumerate_policies(model.num_controls, int(policy_len))
     config = JaxConfig(layout, scheme, int(num_iter), 1.0 if tau is None else float(tau), _nested(policies),
-                       bool(learn_A), bool(learn_B), bool(sample), None if tol is None else float(tol))
+                       bool(learn_A), bool(learn_B), bool(sample), None if tol is None else float(tol), sampling)
     dt = arrays.D[0].dtype
     w = je.EFEWeights(*(jnp.asarray(x, dtype=dt) for x in weights))
     params = AgentParams(arrays, jnp.asarray(gamma, dtype=dt), w, jnp.asarray(lr_A, dtype=dt),
-                         jnp.asarray(lr_B, dtype=dt))
+                         jnp.asarray(lr_B, dtype=dt), jnp.asarray(log_E, dtype=dt), jnp.asarray(alpha, dtype=dt))
     return Agent(config, params)
 
 
@@ -399,12 +418,12 @@ def step(config: JaxConfig, state: AgentState, obs, action=None) -> tuple[AgentS
     policies = np.asarray(config.policies, dtype=np.int32)
     prep = je.prepare(arrays) if config.learn_A or config.learn_B else state.prep
     G = je.policy_efe(layout, arrays, prep, p.weights, qs, jnp.asarray(policies))
-    q_pi = jax.nn.softmax(-p.gamma * G)  # Eq. (4)
-    probs = je.action_distribution(q_pi, policies, layout.num_controls)
+    q_pi = jax.nn.softmax(p.log_E - p.gamma * G)  # Eq. (4), with habits
+    probs = je.action_distribution(q_pi, policies, layout.num_controls, p.alpha, config.sampling)
     key, sub = jax.random.split(state.key)
     if action is None:
-        i = jax.random.categorical(sub, jnp.log(q_pi)) if config.sample else jnp.argmax(q_pi)
-        action = jnp.asarray(policies)[i, 0]
+        action = je.choose_action(sub, q_pi, policies, layout.num_controls, p.alpha, config.sampling,
+                                  config.sample)
     action = jnp.asarray(action, dtype=jnp.int32)
     prior = js.predict(arrays, qs, action)
     params = p._replace(arrays=arrays)

@@ -253,10 +253,8 @@ def init(
                              f"not {planner!r}")
         log_E = check_habits(E, len(enumerate_policies(model.num_controls, int(policy_len))))
     if backend == "jax":
-        if log_E is not None or alpha != 1.0 or sampling != "policy":
-            raise ValueError("habits (E), alpha and sampling='marginal' are not available on the jax backend yet")
         return _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_A, learn_B, lr_A,
-                         lr_B, sample, seed, scheme_options)
+                         lr_B, sample, seed, scheme_options, dict(E=E, alpha=alpha, sampling=sampling))
     if backend != "numpy":
         raise ValueError(f"unknown backend {backend!r} (known: numpy, jax)")
     cfg = LoopConfig(scheme, planner, int(policy_len), float(gamma), objective or efe.pymdp_like(), mcts,
@@ -283,7 +281,7 @@ class JaxLoop(NamedTuple):
 
 
 def _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_A, learn_B, lr_A, lr_B, sample,
-              seed, scheme_options) -> JaxLoop:
+              seed, scheme_options, selection) -> JaxLoop:
     import jax
 
     from cogmap import jax_agent
@@ -292,7 +290,7 @@ def _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_
         raise ValueError(f"the jax backend plans by enumeration only (planner 'enumerate'), got {planner!r}")
     agent = jax_agent.build(model, scheme=scheme, policy_len=int(policy_len), gamma=gamma, objective=objective,
                             learn_A=learn_A, learn_B=learn_B, lr_A=lr_A, lr_B=lr_B, sample=sample,
-                            **(scheme_options or {}))
+                            **selection, **(scheme_options or {}))
     return JaxLoop(model, agent, agent.init(jax.random.key(seed)))
 
 

@@ -236,13 +236,43 @@ def policy_efe(layout, arrays, prep: Prepared, weights: EFEWeights, qs, policies
     return G
 
 
-def action_distribution(q_pi, policies: np.ndarray, num_controls) -> jax.Array:
-    """Probability of each first-step control combination under ``q(pi)``, shaped ``num_controls``."""
-    idx = np.ravel_multi_index(tuple(np.asarray(policies)[:, 0, f] for f in range(len(num_controls))),
-                               tuple(num_controls))
-    flat = jax.ops.segment_sum(q_pi, jnp.asarray(idx), num_segments=int(np.prod(num_controls)))
-    return flat.reshape(tuple(num_controls))
+def action_distribution(q_pi, policies: np.ndarray, num_controls, alpha=1.0, sampling: str = "policy") -> jax.Array:
+    """Probability of each first-step control combination, shaped ``num_controls``: what a sampling
+    agent draws from with action precision ``alpha`` (the JAX form of
+    :func:`cogmap.planning.action_selection.control_probabilities`)."""
+    policies = np.asarray(policies)
+    shape = tuple(int(u) for u in num_controls)
+    if sampling == "marginal":
+        out = jnp.ones(())
+        for f, n in enumerate(shape):  # factors drawn independently from softmax(alpha ln q(u_f))
+            m = jax.ops.segment_sum(q_pi, jnp.asarray(policies[:, 0, f]), num_segments=n)
+            out = jnp.multiply.outer(out, jax.nn.softmax(alpha * jnp.log(jnp.maximum(m, LOG_FLOOR))))
+        return out
+    w = jax.nn.softmax(alpha * jnp.log(jnp.maximum(q_pi, LOG_FLOOR)))
+    idx = np.ravel_multi_index(tuple(policies[:, 0, f] for f in range(len(shape))), shape)
+    flat = jax.ops.segment_sum(w, jnp.asarray(idx), num_segments=int(np.prod(shape)))
+    return flat.reshape(shape)
 
 
-__all__ = ["EFEWeights", "Prepared", "action_distribution", "goal_distances_of", "novelty_weights",
+def choose_action(key, q_pi, policies: np.ndarray, num_controls, alpha=1.0, sampling: str = "policy",
+                  sample: bool = True) -> jax.Array:
+    """``(F,)`` int first-step controls: drawn with ``key`` when ``sample``, else the mode (the JAX
+    form of :func:`cogmap.planning.action_selection.select_action`)."""
+    policies = np.asarray(policies)
+    shape = tuple(int(u) for u in num_controls)
+    if sampling == "marginal":
+        if sample:
+            p = action_distribution(q_pi, policies, shape, alpha, sampling)
+            i = jax.random.categorical(key, jnp.log(jnp.maximum(p.reshape(-1), 1e-300)))
+            return jnp.stack(jnp.unravel_index(i, shape)).astype(jnp.int32)
+        return jnp.stack([jnp.argmax(jax.ops.segment_sum(q_pi, jnp.asarray(policies[:, 0, f]), num_segments=n))
+                          for f, n in enumerate(shape)]).astype(jnp.int32)
+    if sample:
+        i = jax.random.categorical(key, alpha * jnp.log(jnp.maximum(q_pi, LOG_FLOOR)))
+    else:
+        i = jnp.argmax(q_pi)
+    return jnp.asarray(policies)[i, 0].astype(jnp.int32)
+
+
+__all__ = ["EFEWeights", "Prepared", "action_distribution", "choose_action", "goal_distances_of", "novelty_weights",
            "policy_efe", "prepare", "step_values", "weights_of"]

@@ -119,8 +119,58 @@ def test_habits_shift_the_choice():
     (dict(E=np.ones(3)), "E \\(habits\\) must be a vector of 4 weights"),
     (dict(E=np.array([1.0, 0.0, 1.0, 1.0])), "finite and positive"),
     (dict(E=np.ones(4), planner="mcts"), "needs planner 'enumerate'"),
-    (dict(E=np.ones(4), backend="jax"), "not available on the jax backend"),
+    (dict(E=np.ones(3), backend="jax"), "E \\(habits\\) must be a vector of 4 weights"),
+    (dict(alpha=-1.0, backend="jax"), "alpha"),
 ])
 def test_bad_selection_settings_are_refused(kwargs, message):
     with pytest.raises(ValueError, match=message):
         loop.init(tmaze_model(), **kwargs)
+
+
+@pytest.mark.parametrize("sampling, sample", [("policy", True), ("marginal", True), ("marginal", False)])
+def test_the_jax_backend_selects_as_the_numpy_loop(sampling, sample):
+    """Habits, alpha and both sampling modes on the JAX backend: q(pi), G and the action
+    probabilities equal the numpy loop's to 1e-10 in float64 over an episode (same given actions);
+    a deterministic JAX agent takes the numpy agent's action."""
+    jax = pytest.importorskip("jax")
+    model = tmaze_model()
+    P = len(enumerate_policies(model.num_controls, 2))
+    E = np.random.default_rng(2).uniform(0.2, 3.0, size=P)
+    kwargs = dict(policy_len=2, gamma=4.0, E=E, alpha=2.5, sampling=sampling, sample=sample)
+    rng = np.random.default_rng(5)
+    with jax.enable_x64(True):
+        ours, theirs = loop.init(model, **kwargs), loop.init(model, backend="jax", **kwargs)
+        location, context = 0, 1
+        for _ in range(10):
+            obs = [int(rng.choice(n, p=model.live_A(m)[(slice(None), location, context)[: 1 + len(model.A_deps[m])]]))
+                   for m, n in enumerate(model.num_obs)]
+            if not sample:
+                assert loop.step(theirs, obs)[1].action == loop.step(ours, obs)[1].action
+            act = (int(rng.integers(4)), 0)
+            ours, a = loop.step(ours, obs, action=act)
+            theirs, b = loop.step(theirs, obs, action=act)
+            np.testing.assert_allclose(b.q_pi, a.q_pi, rtol=0, atol=1e-10)
+            np.testing.assert_allclose(b.G, a.G, rtol=0, atol=1e-10)
+            np.testing.assert_allclose(b.action_probs, a.action_probs, rtol=0, atol=1e-10)
+            location = act[0]
+
+
+@pytest.mark.parametrize("sampling", ["policy", "marginal"])
+def test_the_jax_agent_draws_from_the_probabilities_it_reports(sampling):
+    jax = pytest.importorskip("jax")
+    from cogmap import jax_agent
+
+    model = tmaze_model()
+    P = len(enumerate_policies(model.num_controls, 2))
+    E = np.random.default_rng(3).uniform(0.2, 3.0, size=P)
+    with jax.enable_x64(True):
+        agent = jax_agent.build(model, policy_len=2, gamma=2.0, E=E, alpha=1.5, sampling=sampling)
+        obs = jax_agent.observation(agent.config.layout, [0, 0, 0])
+        draws = 4000
+        states = jax.vmap(agent.init)(jax.random.split(jax.random.key(0), draws))
+        _, info = jax.jit(jax.vmap(lambda s: agent.step(s, obs)))(states)
+    probs = np.asarray(info.action_probs[0])
+    freq = np.zeros(probs.shape)
+    np.add.at(freq, tuple(np.asarray(info.action).T), 1.0 / draws)
+    assert np.all(np.abs(freq - probs) <= 5 * np.sqrt(probs * (1 - probs) / draws) + 1e-3), (freq, probs)
+    assert probs.max() < 0.99  # not a degenerate case
