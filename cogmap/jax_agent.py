@@ -10,13 +10,15 @@ One ``step`` does what :func:`cogmap.loop.step` does: infer the state posterior 
 scheme, learn ``A`` and ``B`` when asked (Eq. 8 of the AIMAPP paper), evaluate every policy by
 expected free energy, and choose the next control, then predict the next prior through ``B``.
 It also reports ``action_probs``, the probability of every control combination it could take
-(the marginal of ``q(pi)`` over the first step, which it samples from), and takes
+(what it samples from, with habits ``E``, action precision ``alpha`` and the sampling mode of
+:mod:`cogmap.planning.action_selection`), and takes
 ``action=`` to use a given control (a subject's choice) in place of its own: the log-probability
 of a subject's choices is the sum of ``log action_probs[choice]`` over trials
 (:func:`cogmap.fit.log_likelihood`).
 
 Everything that can be fitted or batched is an array in :class:`AgentParams` (the model arrays,
-``gamma``, the EFE weights, the learning rates); the rest is the static :class:`JaxConfig`,
+``gamma``, the EFE weights, the learning rates, the log habits, ``alpha``); the rest is the
+static :class:`JaxConfig`,
 hashed into the jit cache.
 """
 
