@@ -26,6 +26,7 @@ import numpy as np
 
 from cogmap import inference
 from cogmap.genmodel import Model, SpecError
+from cogmap.inference.exact import MAX_JOINT
 from cogmap.inference.learning import learn_observation
 from cogmap.inference.registry import check_options
 from cogmap.planning import efe
@@ -67,6 +68,8 @@ class LoopConfig(NamedTuple):
         Action precision, default 1.
     sampling : str
         ``"policy"`` (default) or ``"marginal"`` (:mod:`cogmap.planning.action_selection`).
+    lr_D, lr_E : float
+        Learning rates of ``pD`` and ``pE`` (:func:`reset`).
     """
     scheme: str = "fpi"
     planner: str = "enumerate"
@@ -83,6 +86,8 @@ class LoopConfig(NamedTuple):
     log_E: np.ndarray | None = None  # log habits over the enumerated policies (None: uniform)
     alpha: float = 1.0  # action precision
     sampling: str = "policy"  # "policy" or "marginal"
+    lr_D: float = 1.0  # learning rate of pD (at reset)
+    lr_E: float = 1.0  # learning rate of pE (at reset)
 
 
 class LoopState(NamedTuple):
@@ -103,7 +108,15 @@ class LoopState(NamedTuple):
     rng : numpy.random.Generator
         Random generator (action sampling, MCTS).
     t : int
-        Number of steps taken.
+        Number of steps taken in this trial (:func:`reset` starts a new one).
+    pD : tuple of numpy.ndarray or None
+        Dirichlet counts of the initial state per factor (``init(pD=...)``), learnt by :func:`reset`.
+    pE : numpy.ndarray or None
+        Dirichlet counts of the habits (``init(pE=...)``), learnt by :func:`reset`.
+    trial : tuple or None
+        With ``pD``: the trial so far, ``(prior, observations, actions)`` (what ``pD`` learns from).
+    q_pi : numpy.ndarray or None
+        Policy posterior of the last step (what ``pE`` learns from).
     """
     model: Model
     config: LoopConfig
@@ -112,6 +125,10 @@ class LoopState(NamedTuple):
     action: tuple | None  # control chosen at the last step (one per factor)
     rng: np.random.Generator
     t: int
+    pD: tuple | None = None  # Dirichlet counts of the initial state (learnt at reset)
+    pE: np.ndarray | None = None  # Dirichlet counts of the habits (learnt at reset)
+    trial: tuple | None = None  # with pD: (prior, observations, actions) of the trial so far
+    q_pi: np.ndarray | None = None  # policy posterior of the last step
 
 
 class StepInfo(NamedTuple):
@@ -165,6 +182,10 @@ def init(
     E=None,
     alpha: float = 1.0,
     sampling: str = "policy",
+    pD=None,
+    pE=None,
+    lr_D: float = 1.0,
+    lr_E: float = 1.0,
     **scheme_options,
 ):
     """A fresh agent on ``model``; the prior is ``D``.
@@ -213,6 +234,16 @@ def init(
     sampling : str, optional
         ``"policy"`` (default: a policy, then its first step; pymdp's ``sampling_mode="full"``) or
         ``"marginal"`` (each factor's control from its marginal; pymdp's default).
+    pD : sequence of array_like, optional
+        Dirichlet counts of the initial state, one ``(num_states[f],)`` non-negative vector per
+        factor: the prior of each trial is ``pD`` normalised (instead of ``D``) and :func:`reset`
+        learns it from the trial's first posterior (SPM's ``d``).
+    pE : array_like, optional
+        Dirichlet counts of the habits over the enumerated policies (positive): ``E`` is ``pE``
+        normalised and :func:`reset` learns it from the last policy posterior (SPM's ``e``). Not
+        with ``E``.
+    lr_D, lr_E : float, optional
+        Their learning rates (SPM's ``eta``), default 1.
     **scheme_options
         Passed to the inference scheme (e.g. ``num_iter=16``).
 
@@ -252,15 +283,101 @@ def init(
             raise ValueError(f"E (habits) weighs the enumerated policies: it needs planner 'enumerate', "
                              f"not {planner!r}")
         log_E = check_habits(E, len(enumerate_policies(model.num_controls, int(policy_len))))
+    num_policies = len(enumerate_policies(model.num_controls, int(policy_len)))
+    pD, pE = _check_prior_counts(model, pD, pE, E, lr_D, lr_E, planner, num_policies)
+    if pE is not None:
+        log_E = check_habits(pE, num_policies)
     if backend == "jax":
+        if pD is not None or pE is not None:
+            raise ValueError("learning D or E (pD, pE) is not available on the jax backend yet")
         return _jax_init(model, scheme, planner, policy_len, gamma, objective, mcts, learn_A, learn_B, lr_A,
                          lr_B, sample, seed, scheme_options, dict(E=E, alpha=alpha, sampling=sampling))
     if backend != "numpy":
         raise ValueError(f"unknown backend {backend!r} (known: numpy, jax)")
     cfg = LoopConfig(scheme, planner, int(policy_len), float(gamma), objective or efe.pymdp_like(), mcts,
-                     learn_A, learn_B, lr_A, lr_B, sample, scheme_options or None, log_E, alpha, sampling)
-    prior = [model.live_D(f).copy() for f in range(len(model.factors))]
-    return LoopState(model, cfg, prior, None, None, np.random.default_rng(seed), 0)
+                     learn_A, learn_B, lr_A, lr_B, sample, scheme_options or None, log_E, alpha, sampling,
+                     float(lr_D), float(lr_E))
+    return LoopState(model, cfg, _trial_prior(model, pD), None, None, np.random.default_rng(seed), 0, pD, pE)
+
+
+def _trial_prior(model: Model, pD) -> list:
+    if pD is None:
+        return [model.live_D(f).copy() for f in range(len(model.factors))]
+    return [d / d.sum() for d in pD]
+
+
+def _check_prior_counts(model: Model, pD, pE, E, lr_D, lr_E, planner, num_policies):
+    for name, lr in (("lr_D", lr_D), ("lr_E", lr_E)):
+        if isinstance(lr, bool) or not isinstance(lr, int | float | np.integer | np.floating) \
+                or not np.isfinite(lr) or lr < 0:
+            raise ValueError(f"{name} must be a finite non-negative number, got {lr!r}")
+    if pD is not None:
+        F = len(model.factors)
+        if isinstance(pD, np.ndarray) and pD.ndim == 1 and F == 1:
+            pD = [pD]
+        if isinstance(pD, str | bytes) or not isinstance(pD, Sequence | np.ndarray) or len(pD) != F:
+            raise ValueError(f"pD must hold one count vector per factor ({F})")
+        out = []
+        for f, d in enumerate(pD):
+            arr = np.asarray(d, dtype=float)
+            n = model.num_states[f]
+            if arr.shape != (n,) or not np.all(np.isfinite(arr)) or np.any(arr < 0) or arr.sum() <= 0:
+                raise ValueError(f"pD for factor '{model.factors[f].name}' must be {n} finite non-negative "
+                                 f"counts with a positive sum, got shape {arr.shape}")
+            out.append(arr.copy())
+        pD = tuple(out)
+    if pE is not None:
+        if E is not None:
+            raise ValueError("give E (fixed habits) or pE (learnt habits), not both")
+        if planner != "enumerate":
+            raise ValueError(f"pE (habits) weighs the enumerated policies: it needs planner 'enumerate', "
+                             f"not {planner!r}")
+        check_habits(pE, num_policies)
+        pE = np.asarray(pE, dtype=float).copy()
+    return pD, pE
+
+
+def reset(state):
+    """Start a new trial: learn ``pD`` and ``pE`` from the trial that ended, then begin from the prior.
+
+    With ``pD`` (SPM's ``spm_MDP_VB_X``): ``pD_f[i] += lr_D * q_1^f[i]`` wherever ``pD_f[i] > 0``,
+    ``q_1`` the belief about the trial's first state given the whole trial, as SPM's ``X(:, 1)``
+    at the end of a trial: the exact smoothed first marginal over the trial's observations and
+    actions when the joint state space is within the ``exact`` scheme's ``MAX_JOINT``, else that
+    of ``mmp`` (marginal message passing, SPM's own scheme). With ``pE``:
+    ``pE += lr_E * q(pi)`` of the trial's last step. The next trial's prior is ``pD`` normalised
+    (else ``D``), its habits ``pE`` normalised; the model (and what it learnt of ``A`` and ``B``)
+    and the random generator carry over.
+
+    Parameters
+    ----------
+    state : LoopState
+        The agent at the end of a trial.
+
+    Returns
+    -------
+    LoopState
+        The agent at the start of the next trial (``t = 0``).
+
+    Raises
+    ------
+    TypeError
+        For a JAX-backend agent (start a new one with ``agent.init``).
+    """
+    if not isinstance(state, LoopState):
+        raise TypeError(f"reset takes a numpy-backend LoopState, got {type(state).__name__}")
+    cfg = state.config
+    pD, pE = state.pD, state.pE
+    if pD is not None and state.trial is not None:
+        prior, observations, actions = state.trial
+        small = int(np.prod(state.model.num_states)) <= MAX_JOINT
+        _, info = inference.get("exact" if small else "mmp")(state.model, prior, observations, actions)
+        first = info.history[0]
+        pD = tuple(d + np.where(d > 0, cfg.lr_D * np.asarray(q), 0.0) for d, q in zip(pD, first, strict=True))
+    if pE is not None and state.q_pi is not None:
+        pE = pE + cfg.lr_E * state.q_pi
+        cfg = cfg._replace(log_E=np.log(pE / pE.sum()))
+    return LoopState(state.model, cfg, _trial_prior(state.model, pD), None, None, state.rng, 0, pD, pE)
 
 
 class JaxLoop(NamedTuple):
@@ -411,5 +528,9 @@ def step(state, observation, action=None):
     probs = None if q_pi is None or policies is None else action_probabilities(q_pi, policies, model.num_controls,
                                                                                   cfg.alpha, cfg.sampling)
     prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
-    nxt = state._replace(prior=prior, qs=qs, action=action, t=state.t + 1)
+    trial = state.trial
+    if state.pD is not None:  # the trial so far, for learning pD at reset
+        trial = ((list(state.prior), [obs], []) if state.t == 0 else
+                 (trial[0], trial[1] + [obs], trial[2] + [state.action]))
+    nxt = state._replace(prior=prior, qs=qs, action=action, t=state.t + 1, trial=trial, q_pi=q_pi)
     return nxt, StepInfo(qs, action, q_pi, G, policies, float(info.free_energy), probs)
