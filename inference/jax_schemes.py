@@ -28,6 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from cogmap.genmodel.compile import real_array
 from cogmap.genmodel.numerics import LOG_FLOOR
 from cogmap.genmodel.numerics import floor_log_jax as floor_log
 
@@ -73,12 +74,16 @@ def one_hot_observation(layout, observation) -> tuple:
     Returns
     -------
     tuple of numpy.ndarray
-        Per modality ``(obs_capacity[m],)`` float: one-hot, the distribution, or zeros (missing).
+        Per modality ``(obs_capacity[m],)`` float: one-hot, the distribution (zero-padded), or
+        zeros (missing). A distribution ``w`` is soft evidence with likelihood
+        ``sum_o w(o) A[o, ...]`` (:func:`evidence`), as in the numpy schemes.
 
     Raises
     ------
     ValueError
-        For the wrong number of entries or an outcome out of range.
+        For the wrong number of entries, an outcome out of range, or a distribution that is not a
+        vector of at most ``obs_capacity[m]`` finite, non-negative entries summing to 1 (the layout
+        does not know the live outcomes: the numpy schemes also refuse mass beyond them).
     """
     if len(observation) != layout.num_modalities:
         raise ValueError(f"an observation has one entry per modality ({layout.num_modalities}), "
@@ -93,10 +98,24 @@ def one_hot_observation(layout, observation) -> tuple:
                 raise ValueError(f"modality {m}: outcome {o} out of range [0, {layout.obs_capacity[m]})")
             v[int(o)] = 1.0
         else:
-            p = np.asarray(o, dtype=float)
+            p = _check_distribution(o, layout.obs_capacity[m], f"modality {m}")
             v[: p.size] = p
         out.append(v)
     return tuple(out)
+
+
+def _check_distribution(o, capacity: int, what: str) -> np.ndarray:
+    """A soft observation as a float vector; refuses what :func:`cogmap.inference.base.prepare` refuses."""
+    p = real_array(o, what, ValueError)
+    if p.ndim != 1 or not 0 < p.size <= capacity:
+        raise ValueError(f"{what}: a distribution over outcomes is a vector of at most {capacity} entries, "
+                         f"got shape {p.shape}")
+    total = p.sum()
+    if not (np.isfinite(total) and p.min() >= 0):
+        raise ValueError(f"{what}: distribution entries must be finite and non-negative")
+    if abs(total - 1.0) > 1e-6:
+        raise ValueError(f"{what}: distribution sums to {total:.6g}, expected 1 (normalise it)")
+    return p
 
 
 def evidence(layout, arrays, obs) -> Evidence:
