@@ -54,8 +54,9 @@ def test_gradients_match_central_finite_differences():
                             objective=fit_objective())
     data = fit.simulate(agent, jax_worlds.tmaze_world(), jax.random.key(7), trials=2, steps=2)
     free = fit.check_free([fit.Free("gamma"), fit.Free("C:1", fit.Normal(1.0, 1.0)), fit.Free("lr_A"),
-                           fit.Free("pA:1"), fit.Free("w:state_info_gain", fit.Normal(1.0, 1.0))], agent)
-    theta = fit.unconstrained(free, jnp.array([2.0, 1.2, 0.8, 1.5, 0.9]))
+                           fit.Free("pA:1"), fit.Free("w:state_info_gain", fit.Normal(1.0, 1.0)),
+                           fit.Free("alpha")], agent)
+    theta = fit.unconstrained(free, jnp.array([2.0, 1.2, 0.8, 1.5, 0.9, 1.3]))
 
     def ll(th):
         return fit.log_likelihood(agent, data, fit.apply(agent.params, free, th))

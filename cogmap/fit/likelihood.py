@@ -17,7 +17,8 @@ Free parameters (:class:`Free`) are named, live on an unconstrained scale (log f
 quantities) and carry a prior on that scale; :func:`apply` writes values into
 :class:`~cogmap.jax_agent.AgentParams`:
 
-``gamma``  policy precision (positive) · ``lr_A``, ``lr_B``  learning rates (positive) ·
+``gamma``  policy precision (positive) · ``alpha``  action precision (positive) · ``lr_A``,
+``lr_B``  learning rates (positive) ·
 ``C:<m>``  scale of the log-preferences of modality ``m`` (an index) · ``pA:<m>``  scale of the
 Dirichlet counts of ``A[m]`` (positive) · ``w:<term>``  the weight of an EFE term of
 :class:`~cogmap.planning.jax_efe.EFEWeights` (e.g. ``w:state_info_gain``).
@@ -70,7 +71,7 @@ class Free(NamedTuple):
     Attributes
     ----------
     name : str
-        ``gamma``, ``lr_A``, ``lr_B``, ``C:<m>``, ``pA:<m>`` or ``w:<term>``.
+        ``gamma``, ``alpha``, ``lr_A``, ``lr_B``, ``C:<m>``, ``pA:<m>`` or ``w:<term>``.
     prior : Normal or LogNormal
         Prior of the value (LogNormal for the positive ones, Normal for ``C:`` and ``w:``).
     """
@@ -79,18 +80,19 @@ class Free(NamedTuple):
     prior: Normal | LogNormal = LogNormal()
 
 
-_POSITIVE = ("gamma", "lr_A", "lr_B", "pA")
+_SCALARS = ("gamma", "alpha", "lr_A", "lr_B")  # fields of AgentParams
+_POSITIVE = (*_SCALARS, "pA")
 
 
 def _kind(name: str) -> tuple[str, str | None]:
     head, _, tail = name.partition(":")
-    if head in ("gamma", "lr_A", "lr_B") and not tail:
+    if head in _SCALARS and not tail:
         return head, None
     if head in ("C", "pA") and tail.isdigit():
         return head, tail
     if head == "w" and tail in EFEWeights._fields:
         return head, tail
-    raise ValueError(f"unknown free parameter {name!r} (known: gamma, lr_A, lr_B, C:<modality>, pA:<modality>, "
+    raise ValueError(f"unknown free parameter {name!r} (known: gamma, alpha, lr_A, lr_B, C:<modality>, pA:<modality>, "
                      f"w:<{'|'.join(EFEWeights._fields)}>)")
 
 
@@ -153,7 +155,7 @@ def apply(params: AgentParams, free, theta) -> AgentParams:
     arrays, weights = params.arrays, params.weights
     for f, v in zip(free, vals, strict=True):
         head, tail = _kind(f.name)
-        if head in ("gamma", "lr_A", "lr_B"):
+        if head in _SCALARS:
             params = params._replace(**{head: v})
         elif head == "C":
             m = int(tail)
