@@ -9,7 +9,8 @@ An agent loop makes one decision with :func:`decide`::
 Lower-level pieces are pure functions of arrays: :mod:`.efe` (terms, :func:`objective`,
 presets), :mod:`.policies` (enumeration, rollouts, softmax selection), :mod:`.action_selection`
 (habits, action precision, the control probabilities a subject's choice is scored by), :mod:`.mcts`,
-:mod:`.inductive`, :mod:`.astar`. Extension points: :func:`register_term` (an EFE term usable by
+:mod:`.inductive`, :mod:`.astar`, :mod:`.sophisticated` (expected free energy recursed over actions and
+outcomes). Extension points: :func:`register_term` (an EFE term usable by
 name in :func:`objective`) and :func:`register_planner` (a planner the agent loop finds by name).
 """
 
@@ -54,6 +55,7 @@ from .policies import (
     policy_posterior,
     select,
 )
+from .sophisticated import SophisticatedConfig, sophisticated_efe
 
 __all__ = [
     "action_selection",
@@ -98,6 +100,8 @@ __all__ = [
     "register_term",
     "select",
     "policy_posterior",
+    "sophisticated_efe",
+    "SophisticatedConfig",
     "state_info_gain",
     "state_preference",
     "ucb_select",

@@ -14,8 +14,10 @@ A planner is any callable
 returning a :class:`Plan`: ``action`` (one integer control per factor), ``G`` (the EFE of what
 was compared: per policy, per root action, ...) and optionally ``q_pi`` and ``policies``.
 :mod:`cogmap.loop` calls it once per step, after inference and learning, and looks it up by the
-name given to ``loop.init(planner=...)``. Three are built in: ``"enumerate"`` (every policy of
-``policy_len`` steps, :func:`~.policies.infer_policies`), ``"mcts"`` (:func:`~.decide.decide`) and
+name given to ``loop.init(planner=...)``. Four are built in: ``"enumerate"`` (every policy of
+``policy_len`` steps, :func:`~.policies.infer_policies`), ``"mcts"`` (:func:`~.decide.decide`),
+``"sophisticated"`` (expected free energy recursed over actions and outcomes, ``policy_len`` steps
+deep, :func:`~.sophisticated.sophisticated_efe`) and
 ``"drone"`` (the drone's waypoint ranking, looking ``policy_len`` waypoints ahead, on a
 :class:`~.drone_planner.DroneScene`, :func:`drone_planner`). Add yours with :func:`register_planner`
 without touching this package; :func:`accepting_planners` lists those that take a given model.
@@ -164,6 +166,28 @@ def mcts_planner(model, qs, objective, settings: PlanSettings) -> Plan:
     return Plan(tuple(int(x) for x in a) + (0,) * (num_factors - a.size), np.asarray(d.Q))
 
 
+def sophisticated_planner(model, qs, objective, settings: PlanSettings) -> Plan:
+    """Sophisticated inference, ``settings.policy_len`` steps deep
+    (:func:`~.sophisticated.sophisticated_planner`, SPM's pruning).
+
+    Parameters
+    ----------
+    model, qs, objective
+        As for :func:`enumerate_planner`.
+    settings : PlanSettings
+        Horizon (``policy_len``), precision, RNG, whether to sample, action precision and sampling.
+
+    Returns
+    -------
+    Plan
+        The chosen control, ``G`` and ``q(u)`` per root joint control, those controls as ``(U, 1, F)``
+        policies, the search's :class:`~.sophisticated.SophisticatedInfo`.
+    """
+    from .sophisticated import sophisticated_planner as plan
+
+    return plan(model, qs, objective, settings)
+
+
 def drone_planner(model: DroneScene, qs, objective, settings):
     """The ``"drone"`` planner: the paper's one-step waypoint
     ranking (:func:`~.drone_planner.plan_waypoints`) when ``settings.policy_len`` is 1, else
@@ -209,11 +233,12 @@ def drone_planner(model: DroneScene, qs, objective, settings):
     return Plan(plan.actions[0], np.asarray(G), None, plan.actions, plan)
 
 
-BUILTIN = {"enumerate": enumerate_planner, "mcts": mcts_planner, "drone": drone_planner}
+BUILTIN = {"enumerate": enumerate_planner, "mcts": mcts_planner, "sophisticated": sophisticated_planner,
+           "drone": drone_planner}
 for _name, _accepts in (("enumerate", (Model, PlanningArrays)), ("mcts", (Model, PlanningArrays)),
-                        ("drone", DroneScene)):
+                        ("sophisticated", (Model, PlanningArrays)), ("drone", DroneScene)):
     PLANNERS.add(_name, BUILTIN[_name], accepts=_accepts)
 PLANNERS.seal()
 
 __all__ = ["Plan", "PlanSettings", "accepting_planners", "available_planners", "drone_planner", "enumerate_planner",
-           "get_planner", "mcts_planner", "register_planner", "unregister_planner"]
+           "get_planner", "mcts_planner", "register_planner", "sophisticated_planner", "unregister_planner"]

@@ -144,7 +144,7 @@ def test_register_planner_errors(registered):
     with pytest.raises(ValueError, match="exists.*overwrite=True"):
         register_planner("west", lambda *a: None)
     assert get_planner("west") is west
-    with pytest.raises(KeyError, match="unknown planner 'nope'.*enumerate, mcts, west"):
+    with pytest.raises(KeyError, match="unknown planner 'nope'.*enumerate, mcts, sophisticated, west"):
         get_planner("nope")
     with pytest.raises(ValueError, match="unknown planner 'nope'.*west"):
         loop.init(corridor(), planner="nope")
