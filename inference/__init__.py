@@ -30,7 +30,7 @@ from .kernel_filter import kernel_filter
 from .mean_field import vmp
 from .message_passing import mmp, vmp_pymdp
 from .particle_scheme import ParticleModel, particle_filter
-from .pymdp_bridge import PymdpImport, from_pymdp, to_pymdp
+from .pymdp_bridge import to_pymdp
 from .registry import accepting, accepts, available, get, register, unregister
 
 
@@ -65,8 +65,6 @@ __all__ = [
     "prepare",
     "register",
     "to_pymdp",
-    "from_pymdp",
-    "PymdpImport",
     "unregister",
     "vmp",
     "vmp_pymdp",

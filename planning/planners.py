@@ -39,6 +39,7 @@ from .arrays import PlanningArrays
 from .drone_lookahead import LookaheadConfig, plan_sequence
 from .drone_planner import DroneScene, plan_waypoints
 from .mcts import MCTSConfig
+from .plan import Plan
 
 
 class PlanSettings(NamedTuple):
@@ -72,30 +73,6 @@ class PlanSettings(NamedTuple):
     log_E: np.ndarray | None = None  # log habits over the enumerated policies (None: uniform)
     alpha: float = 1.0  # action precision
     sampling: str = "policy"  # "policy" or "marginal" (planning.action_selection)
-
-
-class Plan(NamedTuple):
-    """A planner's answer.
-
-    Attributes
-    ----------
-    action : tuple of int
-        One control per factor, to apply now.
-    G : numpy.ndarray
-        Expected free energy (nats) of what was compared: per policy, per root action, ...
-    q_pi : numpy.ndarray or None
-        Posterior over those policies, if the planner has one.
-    policies : numpy.ndarray or None
-        ``(P, T, F)`` policies of ``q_pi`` and ``G`` (enumeration).
-    info : object or None
-        The planner's own record of the decision (the drone's ``PlanResult``).
-    """
-
-    action: tuple  # one integer control per factor, to apply now
-    G: np.ndarray  # expected free energy of what was compared (per policy, per root action, ...)
-    q_pi: np.ndarray | None = None  # posterior over those policies, if the planner has one
-    policies: np.ndarray | None = None  # (P, T, F) policies of q_pi and G (enumeration)
-    info: object = None  # the planner's own record of the decision (the drone's PlanResult)
 
 
 Planner = Callable[..., Plan]

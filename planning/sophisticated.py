@@ -381,7 +381,7 @@ def sophisticated_planner(model, qs, objective, settings, config: SophisticatedC
         ``q_pi = softmax(-gamma G)`` per root joint control, ``policies`` ``(U, 1, F)`` (those
         controls) and ``info`` (:class:`SophisticatedInfo`).
     """
-    from .planners import Plan
+    from .plan import Plan
     from .policies import policy_posterior
 
     G, info = sophisticated_efe(model, qs, objective, settings.policy_len, settings.gamma, config)

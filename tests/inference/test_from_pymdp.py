@@ -14,7 +14,8 @@ from pymdp.agent import Agent  # noqa: E402
 from cogmap import loop  # noqa: E402
 from cogmap.genmodel import compile  # noqa: E402
 from cogmap.genmodel.demo_models import tmaze  # noqa: E402
-from cogmap.inference import from_pymdp, to_pymdp  # noqa: E402
+from cogmap.inference import to_pymdp  # noqa: E402
+from cogmap.pymdp_import import from_pymdp  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
