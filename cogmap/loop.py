@@ -438,31 +438,9 @@ def _observation(model: Model, observation) -> list:
     return list(observation)
 
 
-def action_probabilities(q_pi: np.ndarray, policies: np.ndarray, num_controls, alpha: float = 1.0,
-                         sampling: str = "policy") -> np.ndarray:
-    """Probability of each first-step control combination under ``q_pi``, shaped ``num_controls``
-    (:func:`cogmap.planning.action_selection.control_probabilities`).
-
-    Parameters
-    ----------
-    q_pi : numpy.ndarray
-        ``(P,)`` float policy posterior.
-    policies : numpy.ndarray
-        ``(P, T, F)`` int policies.
-    num_controls : sequence of int
-        Controls per factor.
-    alpha : float, optional
-        Action precision, default 1.
-    sampling : str, optional
-        ``"policy"`` (default) or ``"marginal"``.
-
-    Returns
-    -------
-    numpy.ndarray
-        Float, sums to 1.
-    """
-    return control_probabilities(q_pi, policies, num_controls, alpha, sampling)
-
+#: probability of each first-step control combination (the old name of
+#: :func:`cogmap.planning.action_selection.control_probabilities`)
+action_probabilities = control_probabilities
 
 def _given_action(model: Model, action) -> tuple:
     acts = (action,) if np.ndim(action) == 0 else tuple(action)
@@ -525,8 +503,8 @@ def step(state, observation, action=None):
                          f"{len(model.factors)} factor(s)")
     action = given or action
     q_pi, G, policies = plan.q_pi, np.asarray(plan.G), plan.policies
-    probs = None if q_pi is None or policies is None else action_probabilities(q_pi, policies, model.num_controls,
-                                                                                  cfg.alpha, cfg.sampling)
+    probs = None if q_pi is None or policies is None else control_probabilities(q_pi, policies, model.num_controls,
+                                                                                   cfg.alpha, cfg.sampling)
     prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
     trial = state.trial
     if state.pD is not None:  # the trial so far, for learning pD at reset
