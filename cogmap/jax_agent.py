@@ -282,10 +282,12 @@ def build(
         ``policy_len`` / ``gamma`` / ``num_iter`` / ``tol`` / ``E`` / ``alpha`` / ``sampling``, or
         ``tol`` / ``tau`` given to a scheme that does not take it.
     SpecError
-        For sparse transitions, or learning without the counts it needs.
+        For sparse transitions, transitions that depend on several factors (``B_dependencies``, not
+        yet on the JAX backend), or learning without the counts it needs.
     """
     if not isinstance(model, Model):
         raise TypeError(f"build needs a compiled Model (cogmap.genmodel.compile), got {type(model).__name__}")
+    model.refuse_B_deps("the JAX backend (jax_agent.build)")
     if scheme not in js.SCHEMES:
         raise ValueError(f"unknown scheme {scheme!r} on the JAX backend (known: {', '.join(js.SCHEMES)})")
     if scheme == "filter" and len(model.factors) != 1:

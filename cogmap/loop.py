@@ -505,7 +505,7 @@ def step(state, observation, action=None):
     q_pi, G, policies = plan.q_pi, np.asarray(plan.G), plan.policies
     probs = None if q_pi is None or policies is None else control_probabilities(q_pi, policies, model.num_controls,
                                                                                    cfg.alpha, cfg.sampling)
-    prior = [model.predict(f, qs[f], action[f]) for f in range(len(model.factors))]
+    prior = inference.base.predict_factorised(model, qs, action)
     trial = state.trial
     if state.pD is not None:  # the trial so far, for learning pD at reset
         trial = ((list(state.prior), [obs], []) if state.t == 0 else

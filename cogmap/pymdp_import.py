@@ -47,7 +47,8 @@ def _one(x, index: int, what: str) -> np.ndarray:
 def from_pymdp(agent, index: int = 0) -> PymdpImport:
     """The model and loop settings of a pymdp 1.0 ``Agent`` (the inverse of :func:`to_pymdp`).
 
-    ``A``, ``B``, ``C``, ``D``, ``E``, ``A_dependencies``, ``pA``, ``pB`` and the settings that
+    ``A``, ``B``, ``C``, ``D``, ``E``, ``A_dependencies``, ``B_dependencies`` (as
+    ``Factor.depends_on``), ``pA``, ``pB`` and the settings that
     have a cogmap equivalent are carried over: ``inference_algo`` (``"fpi"``; ``"vmp"`` becomes
     ``vmp_pymdp``, pymdp's schedule; ``"mmp"``), ``num_iter``, ``policy_len``, ``gamma``,
     ``alpha``, ``action_selection`` (``"stochastic"``: ``sample=True``), ``sampling_mode``
@@ -70,8 +71,9 @@ def from_pymdp(agent, index: int = 0) -> PymdpImport:
     Raises
     ------
     ValueError
-        For what cogmap cannot express yet, naming it: transitions that depend on other
-        factors or on several control factors, custom policies, the inductive term, learning
+        For what cogmap cannot express yet, naming it: transitions that depend on several
+        control factors (``B_action_dependencies``), learning ``B`` when transitions depend on
+        other factors, custom policies, the inductive term, learning
         of ``C``, ``D`` or ``E``, an unknown inference algorithm; or a batch entry that is not there.
     """
     from cogmap.genmodel.spec import Factor, Modality, ModelSpec
@@ -81,10 +83,11 @@ def from_pymdp(agent, index: int = 0) -> PymdpImport:
     if not isinstance(index, int | np.integer) or index < 0:
         raise ValueError(f"from_pymdp: index must be a non-negative integer, got {index!r}")
     F, M = len(agent.B), len(agent.A)
-    b_deps = [list(d) for d in (agent.B_dependencies or [[f] for f in range(F)])]
-    if any(d != [f] for f, d in enumerate(b_deps)):
-        raise ValueError(f"from_pymdp: transitions that depend on other factors (B_dependencies {b_deps}) "
-                         "are not supported yet")
+    b_deps = [[int(x) for x in d] for d in (agent.B_dependencies or [[f] for f in range(F)])]
+    multi = any(d != [f] for f, d in enumerate(b_deps))
+    if multi and agent.learn_B:
+        raise ValueError(f"from_pymdp: learning B (learn_B) with transitions that depend on other factors "
+                         f"(B_dependencies {b_deps}) is not supported yet")
     act_deps = getattr(agent, "B_action_dependencies", None)
     if act_deps is not None and [list(d) for d in act_deps] != [[f] for f in range(F)]:
         raise ValueError(f"from_pymdp: B_action_dependencies {act_deps} (controls acting on several factors) "
@@ -108,7 +111,9 @@ def from_pymdp(agent, index: int = 0) -> PymdpImport:
                          f"policy_len {agent.policy_len} (custom policies are not carried over)")
     A = [_one(a, index, f"A[{m}]") for m, a in enumerate(agent.A)]
     B = [_one(b, index, f"B[{f}]") for f, b in enumerate(agent.B)]
-    factors = [Factor(f"factor_{f}", B[f].shape[0], num_controls=num_controls[f]) for f in range(F)]
+    factors = [Factor(f"factor_{f}", B[f].shape[0], num_controls=num_controls[f],
+                      depends_on=None if b_deps[f] == [f] else tuple(f"factor_{d}" for d in b_deps[f]))
+               for f in range(F)]
     a_deps = [list(d) for d in agent.A_dependencies]
     modalities = [Modality(f"modality_{m}", A[m].shape[0], tuple(f"factor_{f}" for f in a_deps[m]))
                   for m in range(M)]

@@ -9,7 +9,7 @@ import numpy as np
 from .likelihood import DenseLikelihood, SparseLikelihood
 from .model import Model, PoseModel
 from .spec import Factor, Modality, ModelSpec, SparseA, SparseB, SpecError
-from .transitions import DenseTransitions, SparseTransitions
+from .transitions import DenseTransitions, DependentTransitions, SparseTransitions
 
 ATOL = 1e-6
 #: largest number of entries of one array a compiled model may reserve (dense A or B at capacity,
@@ -120,6 +120,8 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
         if f.stay is not None and not 0 <= f.stay < f.num_controls:
             raise SpecError(f"factor '{f.name}': stay control {f.stay} out of range")
         factors[f.name] = f
+    for f in spec.factors:
+        _check_factor_deps(f, factors)
     modalities: dict[str, Modality] = {}
     for m in spec.modalities:
         _named(m, Modality, "modality", modalities)
@@ -155,6 +157,33 @@ def _validate_names(spec: ModelSpec) -> tuple[dict[str, Factor], dict[str, Modal
         if name not in spec.B:
             raise SpecError(f"B['{name}']: missing transitions for factor '{name}'")
     return factors, modalities
+
+
+def _check_factor_deps(fac: Factor, factors: dict[str, Factor]) -> None:
+    """Refuse a malformed ``Factor.depends_on`` (as ``Modality.depends_on``, and the factor's own
+    previous state must be among its dependencies)."""
+    deps = fac.depends_on
+    if deps is None:
+        return
+    what = f"factor '{fac.name}'"
+    if isinstance(deps, str) or not isinstance(deps, tuple | list):
+        raise SpecError(f"{what}: depends_on must be a tuple of factor names or None, got {deps!r}")
+    if not deps:
+        raise SpecError(f"{what}: depends_on is empty (leave it None for a factor that depends on itself alone)")
+    twice = sorted({d for d in deps if list(deps).count(d) > 1})
+    if twice:
+        raise SpecError(f"{what}: depends on factor '{twice[0]}' twice (list each factor once)")
+    for dep in deps:
+        if dep not in factors:
+            raise SpecError(f"{what}: depends on missing factor '{dep}' (known: {sorted(factors)})")
+    if fac.name not in deps:
+        raise SpecError(f"{what}: depends_on {list(deps)} must include the factor itself ('{fac.name}'): "
+                        "its next state depends on its own previous state")
+
+
+def _own_deps(fac: Factor) -> bool:
+    """Whether the factor's next state depends on its own previous state alone."""
+    return fac.depends_on is None or tuple(fac.depends_on) == (fac.name,)
 
 
 def compile(spec: ModelSpec, prior_count: float = 1.0, max_entries: int = MAX_ENTRIES) -> Model:  # noqa: A001
@@ -240,17 +269,20 @@ def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, ma
             pfull[tuple(slice(0, n) for n in shape)] = p
         A.append(DenseLikelihood(full, pfull, mod.size, shape[1:]))
 
-    B, D, C_states = [], [], []
-    for fac in spec.factors:
+    B, D, C_states, B_deps = [], [], [], []
+    for f_idx, fac in enumerate(spec.factors):
         n, u, cap = fac.size, fac.num_controls, cap_f[fac.name]
         what = f"B['{fac.name}']"
         raw = spec.B[fac.name]
         counts = None
-        if fac.name in spec.pB:
+        multi = not _own_deps(fac)  # the next state depends on the previous states of several factors
+        if fac.name in spec.pB and not multi:
             counts = _array(spec.pB[fac.name], f"pB['{fac.name}']")
             if counts.shape != (n, n, u):
                 raise SpecError(f"pB['{fac.name}']: shape {counts.shape}, expected {(n, n, u)}")
-        if isinstance(raw, SparseB):
+        if multi:
+            B.append(_dependent_from_spec(spec, fac, factors, order_f, cap_f))
+        elif isinstance(raw, SparseB):
             if raw.counts is not None:
                 if counts is not None:
                     raise SpecError(f"pB['{fac.name}']: the SparseB holds its own counts; give them once")
@@ -276,6 +308,7 @@ def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, ma
                 pfull = np.zeros((cap, cap, u))
                 pfull[:n, :n] = counts
             B.append(DenseTransitions(full, pfull))
+        B_deps.append(B[-1].deps if multi else (f_idx,))
         d = np.zeros(cap)
         if fac.name in spec.D:
             dv = _array(spec.D[fac.name], f"D['{fac.name}']")
@@ -306,6 +339,7 @@ def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, ma
         A=A,
         A_deps=tuple(A_deps),
         B=B,
+        B_deps=tuple(B_deps),
         C=C,
         D=D,
         C_states=C_states,
@@ -316,6 +350,48 @@ def _compile(spec: ModelSpec, factors: dict[str, Factor], prior_count: float, ma
         collision_preference=spec.collision_preference,
         prior_count=prior_count,
     )
+
+
+def _dependent_from_spec(spec: ModelSpec, fac: Factor, factors, order_f, cap_f) -> DependentTransitions:
+    """Dense transitions of a factor whose next state depends on several factors' previous states."""
+    what = f"B['{fac.name}']"
+    deps = tuple(fac.depends_on)
+    raw = spec.B[fac.name]
+    if isinstance(raw, SparseB):
+        raise SpecError(f"{what}: a SparseB cannot depend on other factors (depends_on {list(deps)}); "
+                        "give a dense array shaped (next, *depends_on, control)")
+    for name in deps:
+        dep = factors[name]
+        if dep.growable or cap_f[name] != dep.size:
+            kind = "growable" if dep.growable else f"padded to capacity {cap_f[name]}"
+            who = "it is" if name == fac.name else f"factor '{name}' is"
+            raise SpecError(f"factor '{fac.name}': depends_on {list(deps)} is only supported between factors of "
+                            f"fixed size ({who} {kind}); drop growable/capacity or the extra dependencies")
+        if isinstance(spec.B[name], SparseB) and name != fac.name:
+            raise SpecError(f"factor '{fac.name}': depends on factor '{name}', whose transitions are a SparseB "
+                            "(dependencies are supported between dense factors only)")
+    shape = (fac.size,) + tuple(factors[d].size for d in deps) + (fac.num_controls,)
+    b = _array(raw, what)
+    if b.shape != shape:
+        raise SpecError(f"{what}: shape {b.shape}, expected {shape} (next, *depends_on {list(deps)}, control)")
+    _check_normalised(b, what)
+    own = deps.index(fac.name)
+    if fac.stay is not None:
+        eye = np.eye(fac.size).reshape((fac.size,) + tuple(fac.size if i == own else 1 for i in range(len(deps))))
+        if not np.allclose(b[..., fac.stay], np.broadcast_to(eye, shape[:-1])):
+            raise SpecError(f"{what}: stay control {fac.stay} must keep the factor's own state, whatever the "
+                            "states of its other dependencies")
+    counts = None
+    if fac.name in spec.pB:
+        counts = _array(spec.pB[fac.name], f"pB['{fac.name}']")
+        if counts.shape != shape:
+            raise SpecError(f"pB['{fac.name}']: shape {counts.shape}, expected {shape} (as B['{fac.name}'])")
+        bad = (b > 0) & (counts <= 0)
+        if np.any(bad):
+            idx = tuple(int(i) for i in np.argwhere(bad)[0])
+            raise SpecError(f"pB['{fac.name}']: count 0 at {idx} (next, *depends_on, control) where {what} is "
+                            f"{b[idx]:.6g}; the counts must be positive wherever B is")
+    return DependentTransitions(b, tuple(order_f.index(d) for d in deps), counts, fac.name)
 
 
 def _check_counts_support(prob: np.ndarray, counts: np.ndarray, what: str, of: str, slots: bool = False) -> None:
@@ -348,7 +424,10 @@ def _check_sizes(spec: ModelSpec, factors, cap_f, cap_m, max_entries: int) -> No
     for fac in spec.factors:
         cap, u = cap_f[fac.name], fac.num_controls
         raw = spec.B[fac.name]
-        if isinstance(raw, SparseB):
+        if not _own_deps(fac):
+            shape = (cap,) + tuple(cap_f[d] for d in fac.depends_on) + (u,)
+            check_entries(shape, f"B['{fac.name}']", "or fewer dependencies", max_entries)
+        elif isinstance(raw, SparseB):
             slots = np.shape(raw.succ)[2] if len(np.shape(raw.succ)) == 3 else 1
             check_entries((cap, u, slots), f"B['{fac.name}']", "or fewer successor slots", max_entries)
         else:

@@ -277,7 +277,8 @@ def _layout(meta: dict, max_entries: int) -> dict:
     """Factors, modalities, sizes and capacities of the description, checked and bounded
     before anything is allocated."""
     factors = tuple(
-        Factor(**{**f, "control_names": None if f["control_names"] is None else tuple(f["control_names"])})
+        Factor(**{**f, "control_names": None if f["control_names"] is None else tuple(f["control_names"]),
+                  **({"depends_on": tuple(f["depends_on"])} if f.get("depends_on") is not None else {})})
         for f in meta["factors"]
     )
     modalities = tuple(Modality(**{**m, "depends_on": tuple(m["depends_on"])}) for m in meta["modalities"])

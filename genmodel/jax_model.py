@@ -133,8 +133,12 @@ def to_jax(model, *, goal_dist=None, goal_factor: int = 0, inductive_depth: int 
     Raises
     ------
     SpecError
-        If a factor has sparse transitions (the numpy backend is the path for sparse maps).
+        If a factor has sparse transitions (the numpy backend is the path for sparse maps), or
+        transitions that depend on several factors (``B_dependencies``: numpy backend only, for now).
     """
+    refuse = getattr(model, "refuse_B_deps", None)
+    if refuse is not None:
+        refuse("the JAX backend (to_jax)")
     sparse = [f.name for i, f in enumerate(model.factors) if model.is_sparse(i)]
     if sparse:
         raise SpecError(f"the JAX backend needs dense transitions; factor(s) {', '.join(sparse)} are sparse "

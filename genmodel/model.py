@@ -95,7 +95,8 @@ class Model:
     A_deps : tuple of tuple of int
         Factor indices each modality depends on.
     B : list
-        One :class:`DenseTransitions` or :class:`SparseTransitions` per factor (each owns its counts).
+        One :class:`DenseTransitions` or :class:`SparseTransitions` per factor (each owns its counts),
+        or a :class:`DependentTransitions` for a factor whose next state depends on several factors.
     C : list of numpy.ndarray
         ``(obs_capacity,)`` float log-preferences over the outcomes of each modality.
     D : list of numpy.ndarray
@@ -116,6 +117,9 @@ class Model:
         Dirichlet count given to new states and outcomes by default.
     compile_count : int
         Number of capacity reallocations so far.
+    B_deps : tuple of tuple of int
+        Per factor, the factors whose previous states its next state depends on (pymdp's
+        ``B_dependencies``); default ``(f,)`` for every factor ``f``.
     """
 
     factors: tuple[Factor, ...]
@@ -133,6 +137,34 @@ class Model:
     collision_preference: float | None = None
     prior_count: float = 1.0
     compile_count: int = 0
+    B_deps: tuple[tuple[int, ...], ...] | None = None
+
+    def __post_init__(self):
+        if self.B_deps is None:
+            self.B_deps = tuple((f,) for f in range(len(self.B)))
+        else:
+            self.B_deps = tuple(tuple(int(d) for d in deps) for deps in self.B_deps)
+
+    @property
+    def has_B_deps(self) -> bool:
+        """Whether some factor's next state depends on other factors' previous states."""
+        return any(deps != (f,) for f, deps in enumerate(self.B_deps))
+
+    def refuse_B_deps(self, feature: str, error=SpecError) -> None:
+        """Raise ``error`` naming ``feature`` when some factor's transitions depend on other factors.
+
+        Parameters
+        ----------
+        feature : str
+            What does not support such transitions (a scheme, a planner, a backend).
+        error : type, optional
+            Exception class raised, default :class:`SpecError`.
+        """
+        if self.has_B_deps:
+            multi = {self.factors[f].name: [self.factors[d].name for d in deps]
+                     for f, deps in enumerate(self.B_deps) if deps != (f,)}
+            raise error(f"{feature} does not support transitions that depend on several factors "
+                        f"(B_dependencies {multi}); use a model where each factor depends on itself alone")
 
     # -- names and shapes ------------------------------------------------------------------
     @property
@@ -391,7 +423,8 @@ class Model:
         Returns
         -------
         numpy.ndarray
-            ``(n, n, num_controls)`` float ``B[next, current, control]`` with ``n = num_states[f]``.
+            ``(n, n, num_controls)`` float ``B[next, current, control]`` with ``n = num_states[f]``;
+            ``(n, *sizes of B_deps[f], num_controls)`` for a factor that depends on several.
         """
         return self.B[f].to_dense(self.num_states[f])
 

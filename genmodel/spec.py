@@ -7,7 +7,9 @@ Conventions follow pymdp 1.0 without the batch axis:
 
 * ``A[m]`` has shape ``(num_obs[m], *num_states[deps[m]])`` and each column sums to 1.
 * ``B[f]`` has shape ``(num_states[f], num_states[f], num_controls[f])``; ``B[f][:, s, u]``
-  is the distribution of the next state given state ``s`` and control ``u``.
+  is the distribution of the next state given state ``s`` and control ``u``. A factor with
+  ``depends_on`` (pymdp's ``B_dependencies``) has ``B[f]`` shaped
+  ``(num_states[f], *num_states[depends_on], num_controls[f])``.
   For large topological maps a :class:`SparseB` (padded successor lists) may be given instead.
   A modality over one growable factor may be a :class:`SparseA` (counts only).
 * ``C[m]`` are log-preferences over outcomes (unnormalised, added to the expected utility).
@@ -46,6 +48,11 @@ class Factor:
         The control index that is structurally the identity (never learned), or None.
     control_names : tuple of str or None
         Optional names of the controls.
+    depends_on : tuple of str or None
+        Names of the factors whose previous states the next state of this factor depends on (pymdp
+        1.0's ``B_dependencies``); the factor itself must be among them. ``B`` is then shaped
+        ``(size, *sizes of depends_on, num_controls)``. None (default) means the factor alone,
+        ``B`` shaped ``(size, size, num_controls)``. Dense, non-growable factors only.
     """
 
     name: str
@@ -55,6 +62,7 @@ class Factor:
     capacity: int | None = None
     stay: int | None = None
     control_names: tuple[str, ...] | None = None
+    depends_on: tuple[str, ...] | None = None
 
 
 @dataclass(frozen=True)

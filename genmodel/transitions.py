@@ -658,3 +658,118 @@ class SparseTransitions:
         total = c.sum()
         if total > 0:
             self.prob[s, u] = c / total
+
+
+class DependentTransitions:
+    """Dense transitions of a factor whose next state depends on the previous states of several factors.
+
+    ``prob[next, s_d1, ..., s_dk, control]`` (pymdp 1.0's ``B_dependencies`` layout): the next state
+    of the factor given the previous states of the factors ``deps`` (in that order; the factor itself
+    is among them) and its control. Such a factor is neither growable nor padded to a capacity, so
+    the live block is the whole array. The single-factor operations (``predict``, ``column``,
+    ``control_dense``, ``edges``, learning, growth) do not apply and refuse with an error naming the
+    dependencies; predictions contract ``prob`` with the beliefs of every dependency
+    (:meth:`predict_from`).
+
+    Parameters
+    ----------
+    prob : numpy.ndarray
+        ``(n_f, *n_deps, num_controls)`` float; every column ``prob[:, s_d1, ..., s_dk, u]`` sums to 1.
+    deps : tuple of int
+        Indices of the factors the next state depends on (the axes 1..k of ``prob``).
+    counts : numpy.ndarray or None, optional
+        Dirichlet counts ``pB`` of the same shape, or None.
+    name : str, optional
+        Name of the factor, for messages.
+    """
+
+    def __init__(self, prob: np.ndarray, deps: tuple[int, ...], counts: np.ndarray | None = None, name: str = ""):
+        self.prob = np.asarray(prob, dtype=float)
+        self.deps = tuple(int(d) for d in deps)
+        self.counts = None if counts is None else np.asarray(counts, dtype=float)
+        self.name = name
+        if self.prob.ndim != len(self.deps) + 2:
+            raise ValueError(f"transitions of factor '{name}': {self.prob.ndim} axes for {len(self.deps)} "
+                             "dependencies (expected next, one axis per dependency, control)")
+
+    @property
+    def capacity(self) -> int:
+        """Number of states of the factor (no room is reserved)."""
+        return self.prob.shape[0]
+
+    @property
+    def num_controls(self) -> int:
+        """Number of controls (the last axis of ``prob``)."""
+        return self.prob.shape[-1]
+
+    def predict_from(self, qs_deps, u: int) -> np.ndarray:
+        """Mean-field prediction ``sum_{s_deps} B[:, s_deps, u] prod_d q_d(s_d)``.
+
+        Parameters
+        ----------
+        qs_deps : sequence of numpy.ndarray
+            ``(n_d,)`` float belief of each dependency, in the order of ``deps``.
+        u : int
+            Control index.
+
+        Returns
+        -------
+        numpy.ndarray
+            ``(n_f,)`` float predicted belief.
+        """
+        x = self.prob[..., u]
+        for q in reversed(qs_deps):  # contract the last dependency axis first
+            x = x @ q
+        return x
+
+    def _refuse(self, what: str):
+        from .spec import SpecError
+
+        names = self.name or "this factor"
+        raise SpecError(f"factor '{names}': its transitions depend on the factors {list(self.deps)} "
+                        f"(B_dependencies); {what} needs transitions that depend on the factor alone")
+
+    def predict(self, q: np.ndarray, u: int) -> np.ndarray:
+        """Refused: the prediction needs every dependency's belief (:meth:`predict_from`,
+        :func:`cogmap.inference.base.predict_factorised`)."""
+        self._refuse("a one-factor prediction (use cogmap.inference.base.predict_factorised)")
+
+    def column(self, s: int, u: int, n: int) -> np.ndarray:
+        """Refused (a column needs the states of every dependency)."""
+        self._refuse("a single-state transition column")
+
+    def control_dense(self, u: int, n: int) -> np.ndarray:
+        """Refused (there is no ``(next, current)`` matrix)."""
+        self._refuse("a (next, current) transition matrix")
+
+    def to_dense(self, n: int | None = None) -> np.ndarray:
+        """The whole ``(n_f, *n_deps, num_controls)`` array (a view; nothing is padded)."""
+        return self.prob
+
+    def counts_dense(self, n: int | None = None) -> np.ndarray | None:
+        """The counts (a view), or None without counts."""
+        return self.counts
+
+    def edges(self, threshold: float, n: int):
+        """Refused (moves between states of one factor are not defined)."""
+        self._refuse("the graph of believed-possible moves")
+
+    def control_edges(self, u: int, n: int, min_prob: float):
+        """Refused (moves between states of one factor are not defined)."""
+        self._refuse("the graph of believed-possible moves")
+
+    def learn_soft(self, *args, **kwargs) -> None:
+        """Refused (learning these counts is not supported yet)."""
+        self._refuse("learning B")
+
+    def learn(self, *args, **kwargs) -> None:
+        """Refused (learning these counts is not supported yet)."""
+        self._refuse("learning B")
+
+    def add_state(self, s: int, prior_count: float) -> None:
+        """Refused (the factor is not growable)."""
+        self._refuse("growth")
+
+    def grow(self, capacity: int) -> None:
+        """Refused (the factor is not growable)."""
+        self._refuse("growth")

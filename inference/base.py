@@ -365,8 +365,10 @@ def check_possible(model, prob: Problem, scheme: str) -> None:
     possible = [p > 0 for p in prob.prior]
     for t in range(prob.T):
         if t > 0:
-            possible = [model.predict(f, s.astype(float), int(u)) > 0
-                        for f, (s, u) in enumerate(zip(possible, prob.actions[t - 1], strict=True))]
+            # a factor that depends on several is possible where some possible state of each
+            # dependency leads to it (the mean-field prediction of the masks is positive there)
+            possible = [p > 0 for p in predict_factorised(model, [s.astype(float) for s in possible],
+                                                          prob.actions[t - 1])]
         for ev in prob.evidence[t]:
             if ev.name == POSE_KEY:
                 continue
@@ -388,8 +390,62 @@ def check_possible(model, prob: Problem, scheme: str) -> None:
 
 
 def dense_transition(model, f: int, u: int) -> np.ndarray:
-    """Live dense ``B[f][:, :, u]`` (``(next, current)``), whatever the storage."""
+    """Live dense ``B[f][:, :, u]`` (``(next, current)``), whatever the storage.
+
+    Raises
+    ------
+    InferenceError
+        If the factor's next state depends on other factors too (there is no ``(next, current)``
+        matrix; see :func:`predict_factorised`).
+    """
+    deps = getattr(model, "B_deps", None)
+    if deps is not None and deps[f] != (f,):
+        names = [model.factors[d].name for d in deps[f]]
+        raise InferenceError(f"factor '{model.factors[f].name}': its transitions depend on the factors {names} "
+                             "(B_dependencies); this computation needs transitions that depend on the factor "
+                             "alone")
     return model.B[f].control_dense(u, model.num_states[f])
+
+
+def refuse_B_deps(model, scheme: str) -> None:
+    """Refuse a model in which some factor's next state depends on other factors' previous states.
+
+    Parameters
+    ----------
+    model : Model
+        Compiled model.
+    scheme : str
+        Name of the scheme (or other feature) without support, for the message.
+
+    Raises
+    ------
+    InferenceError
+        Naming ``scheme`` and the factors with dependencies (pymdp's ``B_dependencies``).
+    """
+    refuse = getattr(model, "refuse_B_deps", None)
+    if refuse is not None:
+        refuse(f"{scheme}", InferenceError)
+
+
+def predict_dependent(B, qs, u: int) -> np.ndarray:
+    """Mean-field prediction ``sum_{s_deps} B[:, s_deps, u] prod_d q_d(s_d)`` of one factor whose
+    transitions depend on several factors (pymdp 1.0's ``compute_expected_state``).
+
+    Parameters
+    ----------
+    B : DependentTransitions
+        The factor's transitions (:class:`cogmap.genmodel.transitions.DependentTransitions`).
+    qs : sequence of numpy.ndarray
+        ``(n_g,)`` float belief of every factor ``g`` (those in ``B.deps`` are used).
+    u : int
+        The factor's control.
+
+    Returns
+    -------
+    numpy.ndarray
+        ``(n_f,)`` float predicted belief.
+    """
+    return B.predict_from([np.asarray(qs[d], dtype=float) for d in B.deps], u)
 
 
 def marginal_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs, f: int) -> np.ndarray:
@@ -414,6 +470,11 @@ def expected_loglik(loglik: np.ndarray, deps: tuple[int, ...], qs) -> float:
 def predict_factorised(model, qs, action) -> list[np.ndarray]:
     """Per-factor one-step prediction ``B[f][:, :, u_f] q_f`` (dense or sparse storage).
 
+    A factor whose next state depends on several factors (``model.B_deps[f] != (f,)``) is
+    predicted by contracting its ``B`` with the product of its dependencies' beliefs
+    (mean field, as pymdp 1.0's ``compute_expected_state``): the marginal of the exact joint
+    prediction from the product prior ``prod_f q_f``.
+
     Parameters
     ----------
     model : Model
@@ -428,4 +489,8 @@ def predict_factorised(model, qs, action) -> list[np.ndarray]:
     list of numpy.ndarray
         ``(n_f,)`` float predicted belief per factor.
     """
-    return [model.predict(f, q, int(u)) for f, (q, u) in enumerate(zip(qs, action, strict=True))]
+    deps = getattr(model, "B_deps", None)
+    if deps is None or all(d == (f,) for f, d in enumerate(deps)):
+        return [model.predict(f, q, int(u)) for f, (q, u) in enumerate(zip(qs, action, strict=True))]
+    return [model.predict(f, q, int(u)) if deps[f] == (f,) else predict_dependent(model.B[f], qs, int(u))
+            for f, (q, u) in enumerate(zip(qs, action, strict=True))]

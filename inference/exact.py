@@ -20,6 +20,33 @@ def _apply(B: np.ndarray, x: np.ndarray, axis: int, transpose: bool = False) -> 
     return np.moveaxis(y, 0, axis)
 
 
+_PREV = "abcdefghijklm"
+_NEXT = "nopqrstuvwxyz"
+
+
+def _dependent_step(model, action, F: int):
+    """The joint transition of one step as einsum operands: per factor ``B_f[..., u_f]`` with its
+    subscripts (next state of ``f``, previous states of its dependencies)."""
+    ops, subs = [], []
+    for f, u in enumerate(action):
+        deps = model.B_deps[f]
+        if deps == (f,):
+            ops.append(dense_transition(model, f, u))
+        else:
+            ops.append(model.B[f].prob[..., u])
+        subs.append(_NEXT[f] + "".join(_PREV[d] for d in deps))
+    return ops, subs
+
+
+def _apply_joint(step, x: np.ndarray, F: int, backward: bool = False) -> np.ndarray:
+    """``p(s') = sum_s prod_f B_f(s'_f | s_deps_f) x(s)``, or the backward message
+    ``b(s) = sum_s' prod_f B_f(s'_f | s_deps_f) x(s')``."""
+    ops, subs = step
+    prev, nxt = _PREV[:F], _NEXT[:F]
+    spec = ",".join(subs) + "," + (nxt if backward else prev) + "->" + (prev if backward else nxt)
+    return np.einsum(spec, *ops, x, optimize=True)
+
+
 def _joint_likelihood(evidence, sizes) -> tuple[np.ndarray, float]:
     lik = np.ones(sizes)
     log_scale = 0.0
@@ -42,6 +69,9 @@ def _marginals(joint: np.ndarray) -> tuple[np.ndarray, ...]:
 
 def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_joint: int = MAX_JOINT):
     """Exact Bayes over the joint state space (the prior is taken as a product of factors).
+
+    Transitions that depend on several factors (``model.B_deps``) enter exactly: the joint
+    transition is ``prod_f B_f(s'_f | s_deps_f, u_f)``.
 
     Parameters
     ----------
@@ -76,6 +106,10 @@ def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_
             f"max_joint={max_joint}; use a variational scheme or raise max_joint"
         )
     F = len(sizes)
+    multi = getattr(model, "has_B_deps", False)
+    if multi and F > len(_PREV):
+        raise InferenceError(f"exact: transitions that depend on several factors are supported for up to "
+                             f"{len(_PREV)} factors, the model has {F}")
     alpha = prob.prior[0]
     for f in range(1, F):
         alpha = np.multiply.outer(alpha, prob.prior[f])
@@ -83,7 +117,11 @@ def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_
     alphas, liks, mats = [], [], []
     log_c = []
     for t in range(prob.T):
-        if t > 0:
+        if t > 0 and multi:  # joint transition: product over factors of B_f given its dependencies
+            step = _dependent_step(model, prob.actions[t - 1], F)
+            mats.append(step)
+            alpha = _apply_joint(step, alpha, F)
+        elif t > 0:
             step = [dense_transition(model, f, u) for f, u in enumerate(prob.actions[t - 1])]
             mats.append(step)
             for f in range(F):
@@ -113,7 +151,9 @@ def exact(model, prior, observations, actions=None, *, smooth: bool = True, max_
         gammas = [alphas[-1]]
         for t in range(prob.T - 2, -1, -1):
             x = liks[t + 1] * beta
-            for f in range(F):
+            if multi:
+                x = _apply_joint(mats[t], x, F, backward=True)
+            for f in range(F if not multi else 0):
                 x = _apply(mats[t][f], x, f, transpose=True)
             beta = x / x.max()  # only the shape of beta matters
             g = alphas[t] * beta

@@ -6,6 +6,10 @@ For marginals ``q_t^f`` (time ``t``, factor ``f``), read as the mean-field poste
     F[q] = sum_t sum_f E[log q_t^f] - sum_f E[log D_f(s_1^f)] - sum_t>1 sum_f E[log B_f(s_t^f | s_t-1^f, u_t-1)]
            - sum_t sum_m E[log A_m(o_t^m | s_t)]
 
+A factor whose next state depends on several factors (``model.B_deps[f]``) contributes
+``E[log B_f(s_t^f | s_t-1^deps_f, u_t-1)]`` under the product of the marginals of ``s_t^f`` and of
+its dependencies at ``t - 1``.
+
 Gibbs' inequality makes it an upper bound on ``-log p(o_1:T)`` for any marginals, with
 equality only for the exact posterior when it factorises; so free energies of different schemes
 on the same data are comparable, and none can fall below exact Bayes' ``-log p(o_1:T)``.
@@ -25,6 +29,7 @@ def free_energy_terms(model, prob, prior, marginals, start: int = 0) -> np.ndarr
     ``start + k``: entropy, transition (prior at the first step) and likelihood terms of the step."""
     T = prob.T - start
     terms = np.zeros(T)
+    deps = getattr(model, "B_deps", None)
     for k in range(T):
         q_k = [np.asarray(q, dtype=float) for q in marginals[k]]
         fe = 0.0
@@ -32,6 +37,10 @@ def free_energy_terms(model, prob, prior, marginals, start: int = 0) -> np.ndarr
             fe += xlogx_sum(q_k[f])
             if k == 0:
                 fe -= float(q_k[f] @ floor_log(prior[f]))
+            elif deps is not None and deps[f] != (f,):  # E[log B_f(s^f | s_prev^deps)], product of marginals
+                logB = floor_log(model.B[f].prob[..., prob.actions[start + k - 1][f]])
+                q_prev = [np.asarray(marginals[k - 1][d], dtype=float) for d in deps[f]]
+                fe -= expected_loglik(logB, tuple(range(len(deps[f]) + 1)), [q_k[f], *q_prev])
             else:
                 logB = floor_log(dense_transition(model, f, prob.actions[start + k - 1][f]))
                 fe -= float(q_k[f] @ logB @ np.asarray(marginals[k - 1][f], dtype=float))

@@ -9,7 +9,8 @@ import numpy as np
 def to_pymdp(model, **agent_kwargs):
     """A pymdp 1.0 ``Agent`` holding the live slices of ``model`` with a batch axis of 1.
 
-    ``A``, ``B`` (dense, also from sparse storage), ``C``, ``D``, ``A_dependencies`` and, when
+    ``A``, ``B`` (dense, also from sparse storage), ``C``, ``D``, ``A_dependencies``,
+    ``B_dependencies`` (``model.B_deps``) and, when
     present for every modality/factor, ``pA`` / ``pB`` are passed. Arrays use JAX's default float
     type (enable ``jax_enable_x64`` for double precision). Requires the ``pymdp`` extra.
 
@@ -49,7 +50,7 @@ def to_pymdp(model, **agent_kwargs):
     D = [batched(model.live_D(f)) for f in range(F)]
     kwargs = dict(
         A_dependencies=[list(d) for d in model.A_deps],
-        B_dependencies=[[f] for f in range(F)],
+        B_dependencies=[list(d) for d in getattr(model, "B_deps", None) or [[f] for f in range(F)]],
         num_controls=list(model.num_controls),
     )
     pA = [model.live_pA(m) for m in range(M)]

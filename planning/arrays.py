@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from cogmap.genmodel.likelihood import DenseLikelihood, SparseLikelihood
-from cogmap.genmodel.transitions import DenseTransitions, SparseTransitions
+from cogmap.genmodel.transitions import DenseTransitions, DependentTransitions, SparseTransitions
 
 from . import inductive as ind
 from .efe import EPS, entropy, novelty_weights
@@ -71,6 +71,10 @@ class PlanningArrays:
         Factor whose controls the obstacle signal refers to, default 0.
     view : numpy.ndarray or None
         Per state of ``pose_factor``, the unseen fraction of its view, in [0, 1].
+    B_deps : tuple of tuple of int or None
+        Per factor, the factors whose previous states its next state depends on (pymdp's
+        ``B_dependencies``; ``B[f]`` then has shape ``(n_f, *n_deps, num_controls)``); default
+        ``(f,)`` for every factor.
     """
     A: list  # A[m]: (obs_cap, *state_caps[deps]); live part [:num_obs[m], :num_states...]
     A_deps: tuple
@@ -94,8 +98,12 @@ class PlanningArrays:
     collision_pref: float = -10.0  # log-preference of a collision (no collision: 0)
     control_factor: int = 0  # factor whose controls the obstacle signal refers to
     view: np.ndarray | None = None  # per state of pose_factor: unseen fraction of its view, in [0, 1]
+    B_deps: tuple | None = None  # per factor: factors its next state depends on (default: itself)
 
     def __post_init__(self):
+        deps = tuple((f,) for f in range(len(self.B))) if self.B_deps is None else \
+            tuple(tuple(int(d) for d in fd) for fd in self.B_deps)
+        object.__setattr__(self, "B_deps", deps)
         likelihoods = [
             DenseLikelihood(A, None if self.pA is None else self.pA[m], self.num_obs[m],
                             tuple(self.num_states[f] for f in self.A_deps[m]))
@@ -105,7 +113,9 @@ class PlanningArrays:
         object.__setattr__(self, "A", likelihoods)
         object.__setattr__(self, "pA", None)
         wrapped = [
-            DenseTransitions(B, None if self.pB is None else self.pB[f]) if isinstance(B, np.ndarray) else B
+            (DenseTransitions(B, None if self.pB is None else self.pB[f]) if deps[f] == (f,) else
+             DependentTransitions(B, deps[f], None if self.pB is None else self.pB[f], f"factor_{f}"))
+            if isinstance(B, np.ndarray) else B
             for f, B in enumerate(self.B)
         ]
         object.__setattr__(self, "B", wrapped)
@@ -115,6 +125,11 @@ class PlanningArrays:
     def num_factors(self) -> int:
         """Number of factors."""
         return len(self.B)
+
+    @property
+    def has_B_deps(self) -> bool:
+        """Whether some factor's next state depends on other factors' previous states."""
+        return any(d != (f,) for f, d in enumerate(self.B_deps))
 
     def is_sparse(self, f: int) -> bool:
         """Whether factor ``f`` has sparse transitions.
@@ -263,6 +278,7 @@ def from_model(
         collision_pref=-10.0 if cp is None else float(cp),
         control_factor=pf,
         view=None if view is None else np.asarray(view, dtype=float),
+        B_deps=getattr(model, "B_deps", None),
     )
 
 
@@ -288,7 +304,8 @@ class Prepared:
     local : bool
         Whether this is the local path (one sparse factor, per-state caches).
     B : list of numpy.ndarray
-        Dense path: live ``(n, n, u)`` transition arrays per factor.
+        Dense path: live ``(n, n, u)`` transition arrays per factor (``(n_f, *n_deps, u)`` for a
+        factor that depends on several, ``arrays.B_deps``).
     HA : list of numpy.ndarray
         Dense path: column entropies (nats) of each live ``A[m]``.
     wA : list
@@ -407,6 +424,9 @@ def prepare(
         local = a.num_factors == 1 and a.is_sparse(0)
     if local and not (a.num_factors == 1 and a.is_sparse(0)):
         raise ValueError("the local planning path needs a single factor with sparse transitions")
+    if a.has_B_deps and any(a.is_sparse(f) for f in range(a.num_factors)):
+        raise ValueError("planning with transitions that depend on several factors (B_dependencies) is supported "
+                         "on dense models only; this one has sparse transitions")
     prep = Prepared(arrays=a, local=local, need_novelty=need_novelty)
     if not local:
         prep.B = [a.live_B(f) for f in range(a.num_factors)]

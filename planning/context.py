@@ -93,6 +93,17 @@ def _predict(B: np.ndarray, q: np.ndarray, u: np.ndarray) -> np.ndarray:
     return out
 
 
+def _predict_dependent(B: np.ndarray, qs_deps: list, u: np.ndarray) -> np.ndarray:
+    """``(K, n_f)`` mean-field predictions ``sum_{s_deps} B[:, s_deps, u_k] prod_d q_dk(s_d)`` of a
+    factor whose ``B`` ``(n_f, *n_deps, u)`` depends on several factors, from the candidates'
+    ``(K, n_d)`` beliefs of its dependencies (pymdp 1.0's ``compute_expected_state``)."""
+    out = np.empty((u.shape[0], B.shape[0]))
+    for c in np.unique(u):
+        rows = u == c
+        out[rows] = expect(B[..., c], [q[rows] for q in qs_deps], keep_first=True)
+    return out
+
+
 class _Common:
     prep: Prepared
     collision: np.ndarray | None
@@ -169,7 +180,10 @@ class DenseStep(_Common):
         self.qs_prev = qs_prev
         self.collision = collision
         a = prep.arrays
-        self.qs = [_predict(prep.B[f], q, self.actions[:, f]) for f, q in enumerate(qs_prev)]
+        deps = a.B_deps
+        self.qs = [_predict(prep.B[f], q, self.actions[:, f]) if deps[f] == (f,) else
+                   _predict_dependent(prep.B[f], [qs_prev[d] for d in deps[f]], self.actions[:, f])
+                   for f, q in enumerate(qs_prev)]
         self._a = a
 
     def _expect(self, T, deps, keep_first):
@@ -220,6 +234,7 @@ class DenseStep(_Common):
     def b_novelty(self) -> list:
         """Per factor, ``(K,)`` float information gain about ``B``'s parameters, or None without counts."""
         out = []
+        deps = self._a.B_deps
         for f, w in enumerate(self.prep.wB):
             if w is None:
                 out.append(None)
@@ -228,7 +243,11 @@ class DenseStep(_Common):
             v = np.empty(self.num_candidates)
             for c in np.unique(u):
                 rows = u == c
-                v[rows] = ((self.qs[f][rows] @ w[:, :, c]) * self.qs_prev[f][rows]).sum(axis=1)
+                if deps[f] == (f,):
+                    v[rows] = ((self.qs[f][rows] @ w[:, :, c]) * self.qs_prev[f][rows]).sum(axis=1)
+                else:  # the weights' expectation over the dependencies' previous beliefs, then the next state
+                    ew = expect(w[..., c], [self.qs_prev[d][rows] for d in deps[f]], keep_first=True)
+                    v[rows] = (self.qs[f][rows] * ew).sum(axis=1)
             out.append(v)
         return out
 

@@ -377,6 +377,9 @@ def mcts(
     -----
     Appendix A.3 of the AIMAPP paper; the decision is Eq. (4) over the root children's values.
     """
+    if getattr(prep.arrays, "has_B_deps", False):
+        raise ValueError("mcts does not support transitions that depend on several factors (B_dependencies) "
+                         "yet; use the policy planner (evaluate_policies) for such models")
     cfg = config or MCTSConfig()
     rng = rng if isinstance(rng, np.random.Generator) else np.random.default_rng(rng)
     if prep.local:

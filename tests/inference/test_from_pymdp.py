@@ -115,9 +115,10 @@ def test_what_cannot_be_loaded_is_refused_by_name():
     model = tmaze()
     coupled = to_pymdp(model)
     B = [jnp.asarray(np.ones((1, 4, 4, 2, 4)) / 4), coupled.B[1]]
+    dependent = Agent(coupled.A, B, coupled.C, coupled.D, A_dependencies=[[0], [0, 1], [0, 1]],
+                      B_dependencies=[[0, 1], [1]], num_controls=[4, 1])
+    assert compile(from_pymdp(dependent).spec).B_deps == ((0, 1), (1,))  # B_dependencies load now
     agents = {
-        "B_dependencies": Agent(coupled.A, B, coupled.C, coupled.D, A_dependencies=[[0], [0, 1], [0, 1]],
-                                B_dependencies=[[0, 1], [1]], num_controls=[4, 1]),
         "learn_E": to_pymdp(model, learn_E=True),
         "custom policies": to_pymdp(model, policies=np.zeros((2, 1, 2), dtype=int)),
     }
