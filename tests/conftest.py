@@ -31,3 +31,23 @@ def registered(request):
     yield names
     for name in names:
         request.module.UNREGISTER(name)
+
+
+class _CompiledPymdp:
+    """pymdp 1.0 Agent methods compiled once (``equinox.filter_jit``), called with the agent first:
+    pymdp's own code, without a retrace at every call."""
+
+    def __init__(self):
+        import equinox as eqx
+
+        self.infer_states = eqx.filter_jit(lambda ag, o, p: ag.infer_states(o, p))
+        self.infer_policies = eqx.filter_jit(lambda ag, q: ag.infer_policies(q))
+        self.sample_action = eqx.filter_jit(lambda ag, q, k: ag.sample_action(q, rng_key=k))
+        self.update_empirical_prior = eqx.filter_jit(lambda ag, a, q: ag.update_empirical_prior(a, q))
+
+
+@pytest.fixture
+def pymdp_jit():
+    """:class:`_CompiledPymdp` for tests that step a pymdp Agent through an episode."""
+    pytest.importorskip("equinox")
+    return _CompiledPymdp()

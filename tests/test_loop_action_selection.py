@@ -13,7 +13,7 @@ from cogmap.planning.policies import enumerate_policies
 MODES = {"policy": "full", "marginal": "marginal"}  # ours -> pymdp's sampling_mode
 
 
-def _episode(sampling, sample, steps=20, seed=0):
+def _episode(pj, sampling, sample, steps=20, seed=0):
     jax = pytest.importorskip("jax")
     jnp = pytest.importorskip("jax.numpy")
     pytest.importorskip("pymdp")
@@ -34,10 +34,10 @@ def _episode(sampling, sample, steps=20, seed=0):
     for t in range(steps):
         obs = [int(rng.choice(n, p=model.live_A(m)[(slice(None), location, context)[: 1 + len(model.A_deps[m])]]))
                for m, n in enumerate(model.num_obs)]
-        qs = agent.infer_states([jnp.array([o]) for o in obs], prior)
-        q_pi, neg_efe = agent.infer_policies(qs)
+        qs = pj.infer_states(agent, [jnp.array([o]) for o in obs], prior)
+        q_pi, neg_efe = pj.infer_policies(agent, qs)
         key, k = jax.random.split(key)
-        theirs = np.asarray(agent.sample_action(q_pi, rng_key=jax.random.split(k, 1)))[0]
+        theirs = np.asarray(pj.sample_action(agent, q_pi, jax.random.split(k, 1)))[0]
         own = None if sample else loop.step(state, obs)[1].action  # its own choice (no randomness used)
         state, info = loop.step(state, obs, action=tuple(int(a) for a in theirs))
         for f in range(2):
@@ -45,18 +45,18 @@ def _episode(sampling, sample, steps=20, seed=0):
         np.testing.assert_allclose(-info.G, np.asarray(neg_efe)[0], rtol=0, atol=1e-8)
         np.testing.assert_allclose(info.q_pi, np.asarray(q_pi)[0], rtol=0, atol=1e-8)
         yield t, agent, q_pi, info, theirs, own
-        prior = agent.update_empirical_prior(jnp.array([theirs]), qs)
+        prior = pj.update_empirical_prior(agent, jnp.array([theirs]), qs)
         location = int(theirs[0])
 
 
 @pytest.mark.parametrize("sampling", ["policy", "marginal"])
-def test_habits_and_action_precision_match_pymdp_over_an_episode(sampling):
+def test_habits_and_action_precision_match_pymdp_over_an_episode(sampling, pymdp_jit):
     """Posteriors, EFE and q(pi) with habits agree to 1e-8 over 20 steps given pymdp's sampled
     actions; the reported action probabilities match the frequencies of pymdp's own sampler."""
     import jax
 
     draws = 4000
-    for t, agent, q_pi, info, _, _ in _episode(sampling, sample=True):
+    for t, agent, q_pi, info, _, _ in _episode(pymdp_jit, sampling, sample=True):
         if t not in (0, 7):
             continue
         keys = jax.random.split(jax.random.key(100 + t), draws)
@@ -68,9 +68,9 @@ def test_habits_and_action_precision_match_pymdp_over_an_episode(sampling):
 
 
 @pytest.mark.parametrize("sampling", ["policy", "marginal"])
-def test_deterministic_selection_matches_pymdp(sampling):
+def test_deterministic_selection_matches_pymdp(sampling, pymdp_jit):
     """Without sampling the loop takes the action pymdp's deterministic Agent takes."""
-    for _, _, _, info, theirs, own in _episode(sampling, sample=False, steps=8):
+    for _, _, _, info, theirs, own in _episode(pymdp_jit, sampling, sample=False, steps=8):
         assert own == tuple(int(a) for a in theirs)
         assert tuple(select_action(info.q_pi, info.policies, (4, 1), 3.0, sampling)) == own
 

@@ -219,7 +219,7 @@ def _pymdp_agent(jnp, Agent, seed=0, **kwargs):
 
 
 @pytest.mark.parametrize("param_info_gain", [False, True])
-def test_fpi_episode_matches_pymdp_with_b_dependencies(param_info_gain):
+def test_fpi_episode_matches_pymdp_with_b_dependencies(param_info_gain, pymdp_jit):
     jax = pytest.importorskip("jax")
     jnp = pytest.importorskip("jax.numpy")
     pytest.importorskip("pymdp")
@@ -245,16 +245,16 @@ def test_fpi_episode_matches_pymdp_with_b_dependencies(param_info_gain):
         prior = list(agent.D)
         for _ in range(20):
             obs = [int(rng.choice(3, p=A[0][:, s[0], s[1]])), int(rng.choice(2, p=A[1][:, s[2]]))]
-            qs = agent.infer_states([jnp.array([o]) for o in obs], prior)
-            q_pi, neg_efe = agent.infer_policies(qs)
-            action = np.asarray(agent.sample_action(q_pi, rng_key=jax.random.split(jax.random.key(0), 1)))[0]
+            qs = pymdp_jit.infer_states(agent, [jnp.array([o]) for o in obs], prior)
+            q_pi, neg_efe = pymdp_jit.infer_policies(agent, qs)
+            action = np.asarray(pymdp_jit.sample_action(agent, q_pi, jax.random.split(jax.random.key(0), 1)))[0]
             state, info = loop.step(state, obs, action=tuple(int(a) for a in action))
             for f in range(3):
                 np.testing.assert_allclose(info.qs[f], np.asarray(qs[f])[0, -1], rtol=0, atol=1e-8)
             np.testing.assert_allclose(-info.G, np.asarray(neg_efe)[0], rtol=0, atol=1e-8)
             np.testing.assert_allclose(info.q_pi, np.asarray(q_pi)[0], rtol=0, atol=1e-8)
             assert info.action == tuple(int(a) for a in action)
-            prior = agent.update_empirical_prior(jnp.array([action]), qs)
+            prior = pymdp_jit.update_empirical_prior(agent, jnp.array([action]), qs)
             for f in range(3):  # the loop's next prior is pymdp's empirical prior
                 np.testing.assert_allclose(state.prior[f], np.asarray(prior[f])[0], rtol=0, atol=1e-8)
             s_prev = list(s)

@@ -41,7 +41,7 @@ def _pymdp_tmaze_agent(**kwargs):
                  B_dependencies=env.B_dependencies, **kwargs), env
 
 
-def _run(agent, env, steps=20, seed=0):
+def _run(pj, agent, env, steps=20, seed=0):
     """Step pymdp's agent and the loaded cogmap loop side by side, giving both pymdp's actions."""
     imported = from_pymdp(agent)
     state = loop.init(compile(imported.spec), **imported.settings)
@@ -54,25 +54,25 @@ def _run(agent, env, steps=20, seed=0):
     for _ in range(steps):
         obs = [int(rng.choice(A[m].shape[0], p=A[m][(slice(None),) + tuple(s[f] for f in deps)]))
                for m, deps in enumerate(env.A_dependencies)]
-        qs = agent.infer_states([jnp.array([o]) for o in obs], prior)
-        q_pi, neg_efe = agent.infer_policies(qs)
+        qs = pj.infer_states(agent, [jnp.array([o]) for o in obs], prior)
+        q_pi, neg_efe = pj.infer_policies(agent, qs)
         key, k = jax.random.split(key)
-        action = np.asarray(agent.sample_action(q_pi, rng_key=jax.random.split(k, 1)))[0]
+        action = np.asarray(pj.sample_action(agent, q_pi, jax.random.split(k, 1)))[0]
         own = loop.step(state, obs)[1].action
         state, info = loop.step(state, obs, action=tuple(int(a) for a in action))
         yield qs, q_pi, neg_efe, action, own, info
-        prior = agent.update_empirical_prior(jnp.array([action]), qs)
+        prior = pj.update_empirical_prior(agent, jnp.array([action]), qs)
         s = [int(rng.choice(B[f].shape[0], p=B[f][:, s[f], int(action[f])])) for f in range(2)]
 
 
 @pytest.mark.parametrize("selection, mode", [("stochastic", "marginal"), ("stochastic", "full"),
                                              ("deterministic", "marginal"), ("deterministic", "full")])
-def test_pymdp_tmaze_agent_loaded_gives_the_same_episode(selection, mode):
+def test_pymdp_tmaze_agent_loaded_gives_the_same_episode(selection, mode, pymdp_jit):
     """State posteriors, negative EFE and q(pi) to 1e-8 over a 20-step episode; a deterministic
     agent makes pymdp's choice; a stochastic one reports pymdp's sampling distribution."""
     agent, env = _pymdp_tmaze_agent(policy_len=2, gamma=4.0, alpha=2.0, action_selection=selection,
                                     sampling_mode=mode)
-    for t, (qs, q_pi, neg_efe, action, own, info) in enumerate(_run(agent, env)):
+    for t, (qs, q_pi, neg_efe, action, own, info) in enumerate(_run(pymdp_jit, agent, env)):
         for f in range(2):
             np.testing.assert_allclose(info.qs[f], np.asarray(qs[f])[0, -1], rtol=0, atol=1e-8)
         np.testing.assert_allclose(-info.G, np.asarray(neg_efe)[0], rtol=0, atol=1e-8)

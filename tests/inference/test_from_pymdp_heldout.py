@@ -11,8 +11,6 @@ jax = pytest.importorskip("jax")
 jnp = pytest.importorskip("jax.numpy")
 pytest.importorskip("pymdp")
 
-eqx = pytest.importorskip("equinox")
-
 from pymdp.agent import Agent  # noqa: E402
 from pymdp.control import get_marginals  # noqa: E402
 from pymdp.maths import log_stable  # noqa: E402
@@ -77,7 +75,7 @@ def _pymdp_action_probs(agent, q_pi, mode):
 
 
 @pytest.mark.parametrize("seed, selection, mode", HELD_OUT)
-def test_held_out_pymdp_agent_gives_the_same_episode(seed, selection, mode):
+def test_held_out_pymdp_agent_gives_the_same_episode(seed, selection, mode, pymdp_jit):
     with jax.enable_x64(True):
         agent, A, B, a_deps, b_deps = _random_agent(seed, selection, mode)
         imported = from_pymdp(agent)
@@ -88,17 +86,13 @@ def test_held_out_pymdp_agent_gives_the_same_episode(seed, selection, mode):
         s = [int(rng.integers(len(d))) for d in (np.asarray(x)[0] for x in agent.D)]
         prior = list(agent.D)
         key = jax.random.key(seed)
-        infer_states = eqx.filter_jit(lambda ag, o, p: ag.infer_states(o, p))  # pymdp's own methods,
-        infer_policies = eqx.filter_jit(lambda ag, q: ag.infer_policies(q))  # compiled once per agent
-        sample = eqx.filter_jit(lambda ag, q, k: ag.sample_action(q, rng_key=k))
-        update = eqx.filter_jit(lambda ag, a, q: ag.update_empirical_prior(a, q))
         for _ in range(20):
             obs = [int(rng.choice(A[m].shape[0], p=A[m][(slice(None),) + tuple(s[f] for f in deps)]))
                    for m, deps in enumerate(a_deps)]
-            qs = infer_states(agent, [jnp.array([o]) for o in obs], prior)
-            q_pi, neg_efe = infer_policies(agent, qs)
+            qs = pymdp_jit.infer_states(agent, [jnp.array([o]) for o in obs], prior)
+            q_pi, neg_efe = pymdp_jit.infer_policies(agent, qs)
             key, k = jax.random.split(key)
-            action = tuple(int(a) for a in np.asarray(sample(agent, q_pi, jax.random.split(k, 1)))[0])
+            action = tuple(int(a) for a in np.asarray(pymdp_jit.sample_action(agent, q_pi, jax.random.split(k, 1)))[0])
             own = loop.step(state, obs)[1]
             state, info = loop.step(state, obs, action=action)
             for f in range(3):
@@ -110,7 +104,7 @@ def test_held_out_pymdp_agent_gives_the_same_episode(seed, selection, mode):
             assert info.action == action  # the loop acted as it was told
             if selection == "deterministic":
                 assert own.action == action  # and, left to itself, makes pymdp's choice
-            prior = update(agent, jnp.array([action]), qs)
+            prior = pymdp_jit.update_empirical_prior(agent, jnp.array([action]), qs)
             for f in range(3):
                 np.testing.assert_allclose(state.prior[f], np.asarray(prior[f])[0], rtol=0, atol=1e-8)
             s = [int(rng.choice(B[f].shape[0], p=B[f][(slice(None),) + tuple(s[d] for d in deps) + (action[f],)]))
