@@ -139,6 +139,16 @@ class _Common:
         """Log-preference of a collision (no collision: 0)."""
         return self.prep.arrays.collision_pref
 
+    def _expect(self, T, deps, keep_first):
+        """``T`` contracted with the predicted beliefs of the factors ``deps`` (:func:`expect`)."""
+        qs = [self.qs[f] for f in deps]
+        if len(deps) == 1:
+            return expect(T, qs, keep_first)
+        joints = self.__dict__.setdefault("_joints", {})  # modalities that share factors share the joint
+        if deps not in joints:
+            joints[deps] = joint(qs)
+        return expect(T, qs, keep_first, joints[deps])
+
     @cached_property
     def closer(self):
         """``(K,)`` float probability of moving strictly closer to a goal state, or None without a goal.
@@ -185,15 +195,6 @@ class DenseStep(_Common):
                    _predict_dependent(prep.B[f], [qs_prev[d] for d in deps[f]], self.actions[:, f])
                    for f, q in enumerate(qs_prev)]
         self._a = a
-
-    def _expect(self, T, deps, keep_first):
-        qs = [self.qs[f] for f in deps]
-        if len(deps) == 1:
-            return expect(T, qs, keep_first)
-        joints = self.__dict__.setdefault("_joints", {})  # modalities that share factors share the joint
-        if deps not in joints:
-            joints[deps] = joint(qs)
-        return expect(T, qs, keep_first, joints[deps])
 
     @cached_property
     def qo(self) -> list:
@@ -353,15 +354,6 @@ class LocalStep(_Common):
     def _stats(self) -> list:
         """Per modality: column entropies and novelty weights of the states in ``U``."""
         return [self.prep.column_stats(m, self.U) for m in range(len(self._a.A))]
-
-    def _expect(self, T, deps, keep_first):
-        qs = [self.qs[f] for f in deps]
-        if len(deps) == 1:
-            return expect(T, qs, keep_first)
-        joints = self.__dict__.setdefault("_joints", {})  # modalities that share factors share the joint
-        if deps not in joints:
-            joints[deps] = joint(qs)
-        return expect(T, qs, keep_first, joints[deps])
 
     @cached_property
     def qo(self) -> list:
