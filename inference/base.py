@@ -407,6 +407,38 @@ def dense_transition(model, f: int, u: int) -> np.ndarray:
     return model.B[f].control_dense(u, model.num_states[f])
 
 
+def transition_array(model, f: int, u: int) -> np.ndarray:
+    """Live ``B[f][..., u]``: ``(next, current)`` (:func:`dense_transition`), or ``(next, *deps)``
+    for a factor whose next state depends on several factors (``model.B_deps[f]``)."""
+    deps = getattr(model, "B_deps", None)
+    if deps is not None and deps[f] != (f,):
+        return model.B[f].prob[..., u]
+    return dense_transition(model, f, u)
+
+
+def b_deps_of(model) -> tuple[tuple[int, ...], ...]:
+    """Per factor, the factors its next state depends on (``(f,)`` alone without ``B_deps``)."""
+    deps = getattr(model, "B_deps", None)
+    return tuple((f,) for f in range(len(model.B))) if deps is None else deps
+
+
+def forward_message(b: np.ndarray, deps_f: tuple[int, ...], f: int, q_prev) -> np.ndarray:
+    """``b`` (``B`` or ``log B`` of factor ``f``, as :func:`transition_array`) contracted with the
+    beliefs ``q_prev[d]`` of its dependencies at the previous step: a function of ``s_t^f``."""
+    if deps_f == (f,):
+        return b @ q_prev[f]
+    return marginal_loglik(b, tuple(range(len(deps_f) + 1)), [None] + [q_prev[d] for d in deps_f], 0)
+
+
+def backward_message(log_b: np.ndarray, deps_g: tuple[int, ...], g: int, f: int, q_next_g, q_now) -> np.ndarray:
+    """``E[log B_g(s_t+1^g | s_t^deps_g)]`` as a function of ``s_t^f`` (``f`` in ``deps_g``), under
+    ``q_next_g`` and the beliefs ``q_now[d]`` at ``t`` of ``g``'s other dependencies."""
+    if deps_g == (g,):
+        return q_next_g @ log_b
+    local = [q_next_g] + [q_now[d] for d in deps_g]
+    return marginal_loglik(log_b, tuple(range(len(deps_g) + 1)), local, 1 + deps_g.index(f))
+
+
 def refuse_B_deps(model, scheme: str) -> None:
     """Refuse a model in which some factor's next state depends on other factors' previous states.
 

@@ -34,13 +34,16 @@ import numpy as np
 from .base import (
     InferenceError,
     InferenceInfo,
+    b_deps_of,
+    backward_message,
     check_num_iter,
     check_possible,
-    dense_transition,
     floor_log,
+    forward_message,
     marginal_loglik,
     prepare,
     softmax,
+    transition_array,
 )
 from .free_energy import free_energy_terms
 from .message_passing import check_window, filter_before_window
@@ -83,9 +86,13 @@ def coordinate_sweeps(model, prob, start: int, prior, num_iter: int, tol: float 
     """
     T = prob.T - start
     F = prob.num_factors
-    if getattr(model, "has_B_deps", False):
-        return _dependent_sweeps(model, prob, start, prior, num_iter, tol)
-    logB = [[floor_log(dense_transition(model, f, prob.actions[start + t][f])) for f in range(F)]
+    # with transitions that depend on several factors (model.B_deps) the transition term of factor g
+    # at t is E[log B_g(s_t^g | s_t-1^deps_g)] under the product of marginals; its message to a
+    # marginal is its expectation over every other marginal it involves, so each update is still the
+    # exact coordinate minimiser of the window's free energy
+    deps = b_deps_of(model)
+    users = [[g for g in range(F) if f in deps[g]] for f in range(F)]
+    logB = [[floor_log(transition_array(model, g, prob.actions[start + t][g])) for g in range(F)]
             for t in range(T - 1)]
     logliks = [[(ev.deps, floor_log(ev.lik)) for ev in prob.evidence[start + t]] for t in range(T)]
     log_prior = [floor_log(p) for p in prior]
@@ -96,53 +103,10 @@ def coordinate_sweeps(model, prob, start: int, prior, num_iter: int, tol: float 
         moved = 0.0
         for t in range(T):
             for f in range(F):
-                x = log_prior[f] if t == 0 else logB[t - 1][f] @ qs[t - 1][f]
-                if t < T - 1:
-                    x = x + qs[t + 1][f] @ logB[t][f]
-                for deps, ll in logliks[t]:
-                    if f in deps:
-                        x = x + marginal_loglik(ll, deps, qs[t], f)
-                new = softmax(x)
-                moved = max(moved, float(np.abs(new - qs[t][f]).max()))
-                qs[t][f] = new
-        if tol is not None and moved <= tol:
-            break
-    return qs, sweeps
-
-
-def _dependent_sweeps(model, prob, start: int, prior, num_iter: int, tol: float | None):
-    """:func:`coordinate_sweeps` for transitions that depend on several factors (``model.B_deps``).
-
-    The transition term of factor ``g`` at step ``t`` is ``E[log B_g(s_t^g | s_t-1^deps_g)]`` under
-    the product of marginals; its message to ``q_t-1^f`` (``f`` in ``deps_g``) or ``q_t^g`` is its
-    expectation over every other marginal it involves, so each update is still the exact coordinate
-    minimiser of the window's free energy.
-    """
-    T = prob.T - start
-    F = prob.num_factors
-    deps = model.B_deps
-    logB = [[floor_log(model.B[g].prob[..., prob.actions[start + t][g]] if deps[g] != (g,)
-                       else dense_transition(model, g, prob.actions[start + t][g])) for g in range(F)]
-            for t in range(T - 1)]
-    logliks = [[(ev.deps, floor_log(ev.lik)) for ev in prob.evidence[start + t]] for t in range(T)]
-    log_prior = [floor_log(p) for p in prior]
-    qs = [[np.full(n, 1.0 / n) for n in prob.sizes] for _ in range(T)]
-    axes = [tuple(range(len(d) + 1)) for d in deps]  # (next, *deps) as positions in a local list
-    sweeps = 0
-    while sweeps < num_iter:
-        sweeps += 1
-        moved = 0.0
-        for t in range(T):
-            for f in range(F):
-                if t == 0:
-                    x = log_prior[f]
-                else:  # own transition from the dependencies at t - 1
-                    x = marginal_loglik(logB[t - 1][f], axes[f], [None] + [qs[t - 1][d] for d in deps[f]], 0)
+                x = log_prior[f] if t == 0 else forward_message(logB[t - 1][f], deps[f], f, qs[t - 1])
                 if t < T - 1:  # every factor whose transition to t + 1 depends on f
-                    for g in range(F):
-                        if f in deps[g]:
-                            local = [qs[t + 1][g]] + [qs[t][d] for d in deps[g]]
-                            x = x + marginal_loglik(logB[t][g], axes[g], local, 1 + deps[g].index(f))
+                    for g in users[f]:
+                        x = x + backward_message(logB[t][g], deps[g], g, f, qs[t + 1][g], qs[t])
                 for mdeps, ll in logliks[t]:
                     if f in mdeps:
                         x = x + marginal_loglik(ll, mdeps, qs[t], f)

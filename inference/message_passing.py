@@ -31,34 +31,39 @@ from .base import (
     LOG_FLOOR,
     InferenceError,
     InferenceInfo,
+    b_deps_of,
+    backward_message,
     check_num_iter,
     check_possible,
-    dense_transition,
     floor_log,
+    forward_message,
     marginal_loglik,
     predict_factorised,
     prepare,
     softmax,
+    transition_array,
 )
 from .fpi import fpi_step
 from .free_energy import free_energy_terms
 
 
-def _run_dependent(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
-    """:func:`_run` for transitions that depend on several factors (``model.B_deps``), with pymdp
-    1.0's messages: the forward message of ``q_t^f`` contracts ``B_f`` (``log B_f`` for vmp) with
-    the dependencies' beliefs at ``t - 1``; the backward one sums, over every factor ``g`` whose
-    transition depends on ``f``, the message from ``q_t+1^g`` through ``B_g`` contracted with the
-    beliefs at ``t`` of ``g``'s other dependencies."""
+def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
+    """pymdp 1.0's simultaneous updates (``vmp_pymdp``) or marginal message passing (``mmp``) over
+    the steps ``start..T-1``. With transitions that depend on several factors (``model.B_deps``)
+    the forward message of ``q_t^f`` contracts ``B_f`` (``log B_f`` for vmp) with the dependencies'
+    beliefs at ``t - 1``; the backward one sums, over every factor ``g`` whose transition depends on
+    ``f``, the message from ``q_t+1^g`` through ``B_g`` contracted with the beliefs at ``t`` of
+    ``g``'s other dependencies."""
     T = prob.T - start
     F = prob.num_factors
     sizes = prob.sizes
-    deps = model.B_deps
-    B = [[model.B[g].prob[..., prob.actions[start + t][g]] if deps[g] != (g,)
-          else dense_transition(model, g, prob.actions[start + t][g]) for g in range(F)] for t in range(T - 1)]
-    logB = [[floor_log(b) for b in step] for step in B]
-    axes = [tuple(range(len(d) + 1)) for d in deps]
+    deps = b_deps_of(model)
     users = [[g for g in range(F) if f in deps[g]] for f in range(F)]
+    B = [[transition_array(model, g, prob.actions[start + t][g]) for g in range(F)] for t in range(T - 1)]
+    logB = [[floor_log(b) for b in step] for step in B]
+    if kind == "mmp":  # backward matrices of factors that depend on themselves alone, once
+        Bn = [[_normalised_columns(b, deps[g], g, None) if deps[g] == (g,) else None for g, b in enumerate(step)]
+              for step in B]
     logliks = [[(ev.deps, floor_log(ev.lik)) for ev in prob.evidence[start + t]] for t in range(T)]
     log_prior = [floor_log(p) for p in prior]
     qs = [[np.full(n, 1.0 / n) for n in sizes] for _ in range(T)]
@@ -72,75 +77,37 @@ def _run_dependent(model, prob, start: int, prior, kind: str, num_iter: int, tau
                 for mdeps, ll in logliks[t]:
                     if f in mdeps:
                         ln_a = ln_a + marginal_loglik(ll, mdeps, qs[t], f)
-                last = t == T - 1
-                prev = [None] + ([qs[t - 1][d] for d in deps[f]] if t else [])
+                after = () if t == T - 1 else users[f]
                 if kind == "vmp_pymdp":
-                    fwd = log_prior[f] if t == 0 else marginal_loglik(logB[t - 1][f], axes[f], prev, 0)
+                    fwd = log_prior[f] if t == 0 else forward_message(logB[t - 1][f], deps[f], f, qs[t - 1])
                     bwd = 0.0
-                    for g in users[f] if not last else ():
-                        local = [qs[t + 1][g]] + [qs[t][d] for d in deps[g]]
-                        bwd = bwd + marginal_loglik(logB[t][g], axes[g], local, 1 + deps[g].index(f))
+                    for g in after:
+                        bwd = bwd + backward_message(logB[t][g], deps[g], g, f, qs[t + 1][g], qs[t])
                 else:
-                    fwd = log_prior[f] if t == 0 else floor_log(marginal_loglik(B[t - 1][f], axes[f], prev, 0))
-                    if not last:
+                    fwd = log_prior[f] if t == 0 else floor_log(forward_message(B[t - 1][f], deps[f], f, qs[t - 1]))
+                    if t < T - 1:
                         fwd = 0.5 * fwd
                     bwd = 0.0
-                    for g in users[f] if not last else ():
-                        # B_g with g's other dependencies contracted at t: (next of g, state of f)
-                        k = deps[g].index(f)
-                        x = B[t][g]
-                        for j in range(len(deps[g]) - 1, -1, -1):
-                            if j != k:
-                                x = np.moveaxis(x, 1 + j, -1) @ qs[t][deps[g][j]]
-                        bn = x / np.maximum(x.sum(axis=1, keepdims=True), LOG_FLOOR)
+                    for g in after:
+                        bn = Bn[t][g] if Bn[t][g] is not None else _normalised_columns(B[t][g], deps[g], f, qs[t])
                         bwd = bwd + 0.5 * floor_log(qs[t + 1][g] @ bn)
-                ln_q = ln_q + tau * (ln_a - ln_q + bwd + fwd)
-                row.append(softmax(ln_q))
-            new.append(row)
-        qs = new
-    return qs, free_energy_terms(model, prob, prior, qs, start)
-
-
-def _run(model, prob, start: int, prior, kind: str, num_iter: int, tau: float):
-    if getattr(model, "has_B_deps", False):
-        return _run_dependent(model, prob, start, prior, kind, num_iter, tau)
-    T = prob.T - start
-    F = prob.num_factors
-    sizes = prob.sizes
-    B = [[dense_transition(model, f, prob.actions[start + t][f]) for f in range(F)] for t in range(T - 1)]
-    logB = [[floor_log(b) for b in step] for step in B]
-    if kind == "mmp":
-        Bn = [[b / np.maximum(b.sum(axis=1, keepdims=True), LOG_FLOOR) for b in step] for step in B]
-    logliks = [
-        [(ev.deps, floor_log(ev.lik), ev.log_scale) for ev in prob.evidence[start + t]] for t in range(T)
-    ]
-    log_prior = [floor_log(p) for p in prior]
-    qs = [[np.full(n, 1.0 / n) for n in sizes] for _ in range(T)]
-    for _ in range(num_iter):
-        new = []
-        for t in range(T):
-            row = []
-            for f in range(F):
-                ln_q = floor_log(qs[t][f])
-                ln_a = np.zeros(sizes[f])
-                for deps, ll, _ in logliks[t]:
-                    if f in deps:
-                        ln_a = ln_a + marginal_loglik(ll, deps, qs[t], f)
-                last = t == T - 1
-                if kind == "vmp_pymdp":
-                    fwd = log_prior[f] if t == 0 else logB[t - 1][f] @ qs[t - 1][f]
-                    bwd = 0.0 if last else qs[t + 1][f] @ logB[t][f]
-                else:
-                    fwd = log_prior[f] if t == 0 else floor_log(B[t - 1][f] @ qs[t - 1][f])
-                    if not last:
-                        fwd = 0.5 * fwd
-                    bwd = 0.0 if last else 0.5 * floor_log(qs[t + 1][f] @ Bn[t][f])
                 ln_q = ln_q + tau * (ln_a - ln_q + bwd + fwd)
                 row.append(softmax(ln_q))
             new.append(row)
         qs = new
     # mean-field free energy of the window, split so the last step's terms can be reported
     return qs, free_energy_terms(model, prob, prior, qs, start)
+
+
+def _normalised_columns(b: np.ndarray, deps_g: tuple[int, ...], f: int, q_now) -> np.ndarray:
+    """mmp's backward matrix: ``B_g`` with ``g``'s dependencies other than ``f`` contracted with
+    their beliefs ``q_now``, as ``(next of g, state of f)``, each row normalised over ``s^f``."""
+    k = deps_g.index(f)
+    x = b
+    for j in range(len(deps_g) - 1, -1, -1):
+        if j != k:
+            x = np.moveaxis(x, 1 + j, -1) @ q_now[deps_g[j]]
+    return x / np.maximum(x.sum(axis=1, keepdims=True), LOG_FLOOR)
 
 
 def check_window(window, scheme: str) -> int | None:
