@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import InferenceError, InferenceInfo, dense_transition, prepare
+from .base import InferenceError, InferenceInfo, dense_transition, prepare, transition_array
 
 MAX_JOINT = 1 << 16
 
@@ -29,12 +29,8 @@ def _dependent_step(model, action, F: int):
     subscripts (next state of ``f``, previous states of its dependencies)."""
     ops, subs = [], []
     for f, u in enumerate(action):
-        deps = model.B_deps[f]
-        if deps == (f,):
-            ops.append(dense_transition(model, f, u))
-        else:
-            ops.append(model.B[f].prob[..., u])
-        subs.append(_NEXT[f] + "".join(_PREV[d] for d in deps))
+        ops.append(transition_array(model, f, u))
+        subs.append(_NEXT[f] + "".join(_PREV[d] for d in model.B_deps[f]))
     return ops, subs
 
 
